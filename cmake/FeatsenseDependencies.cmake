@@ -1,0 +1,13 @@
+# Every dependency comes from Debian's packages through find_package; nothing is downloaded.
+find_package(Threads REQUIRED)
+# TBB first: otherwise OpenVDB's FindTBB and Ceres' SuiteSparse lookup define the same targets.
+find_package(TBB CONFIG REQUIRED)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(yaml-cpp REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(spdlog CONFIG REQUIRED)
+find_package(nlohmann_json 3 CONFIG REQUIRED)
+find_package(BZip2 REQUIRED)
+find_package(liblzf CONFIG REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)

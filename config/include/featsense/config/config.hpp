@@ -1,0 +1,63 @@
+#pragma once
+/// The typed configuration of a run. In-class defaults are the documented defaults of
+/// config/default.yaml (a test keeps the two equal). Only config/ parses YAML.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace featsense::config {
+
+struct SensorConfig {
+  /// "auto": the recording's own metadata, else its sequence.yaml, else the reader's guess.
+  std::string preset = "auto";
+  std::optional<double> min_range_m;  ///< metres; unset: the sensor model's own limit
+  std::optional<double> max_range_m;  ///< metres; unset: the sensor model's own limit
+};
+
+enum class Backend { kAuto, kCuda, kCpu };
+
+struct MapConfig {
+  double voxel_size_m = 0.064;
+  double truncation_m = 0.6;
+  double max_weight = 10.0;
+  std::array<double, 3> size_m = {40.0, 40.0, 15.0};
+  double shift_threshold_m = 3.0;
+  Backend backend = Backend::kAuto;
+};
+
+struct OdometryConfig {
+  int optimization_steps = 3;
+  bool intensity_fusion = true;
+  bool deskew = true;
+};
+
+struct RefineConfig {
+  bool enabled = true;
+  double distance_m = 2.0;
+};
+
+struct Config {
+  SensorConfig sensor;
+  MapConfig map;
+  OdometryConfig odometry;
+  RefineConfig refine;
+};
+
+std::string to_string(Backend backend);
+
+/// Builds the configuration of a run: the defaults, then the YAML file (if any), then each
+/// `key=value` override in order. Throws ConfigError naming the key and where it came from
+/// for unknown keys (with a did-you-mean), wrong types and out-of-range values.
+Config load_config(const std::optional<std::string>& yaml_path,
+                   const std::vector<std::string>& overrides = {});
+/// The same from YAML text instead of a file; `origin` names it in messages.
+Config load_config_text(const std::string& yaml_text, const std::string& origin,
+                        const std::vector<std::string>& overrides = {});
+/// The whole configuration as YAML, every key present, in the layout of default.yaml.
+std::string to_yaml(const Config& config);
+/// Every key path, e.g. "map.voxel_size", in schema order.
+std::vector<std::string> config_keys();
+
+}  // namespace featsense::config

@@ -1,0 +1,231 @@
+#include "config_schema.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "featsense/config/config_error.hpp"
+#include "featsense/config/sensor_model.hpp"
+
+namespace featsense::config::detail {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Range {
+  double min = -kInf;
+  double max = kInf;
+  bool min_exclusive = false;  ///< "> min" rather than ">= min"
+};
+
+std::string describe(const Range& r) {
+  std::ostringstream s;
+  if (r.min > -kInf) s << (r.min_exclusive ? "> " : ">= ") << r.min;
+  if (r.min > -kInf && r.max < kInf) s << " and ";
+  if (r.max < kInf) s << "<= " << r.max;
+  return s.str();
+}
+
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
+  throw ConfigError(where + ": " + what);
+}
+
+double parse_number(const YAML::Node& node, const std::string& where, const Range& range) {
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    fail(where, "expected a number");
+  }
+  if (!std::isfinite(value)) fail(where, "expected a finite number, got " + node.Scalar());
+  const bool below = range.min_exclusive ? value <= range.min : value < range.min;
+  if (below || value > range.max) {
+    fail(where, "value " + node.Scalar() + " is out of range (must be " + describe(range) + ")");
+  }
+  return value;
+}
+
+template <typename Section, typename Field>
+using Member = Field Section::*;
+
+template <typename Section>
+using SectionOf = Section Config::*;
+
+template <typename Section>
+KeySpec number_key(std::string path, SectionOf<Section> section, Member<Section, double> field,
+                   Range range) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            (c.*section).*field = parse_number(v, where, range);
+          },
+          [=](const Config& c) { return YAML::Node((c.*section).*field); }};
+}
+
+template <typename Section>
+KeySpec optional_number_key(std::string path, SectionOf<Section> section,
+                            Member<Section, std::optional<double>> field, Range range) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            if (v.IsNull() || (v.IsScalar() && v.Scalar() == "auto")) {
+              (c.*section).*field = std::nullopt;
+            } else {
+              (c.*section).*field = parse_number(v, where, range);
+            }
+          },
+          [=](const Config& c) {
+            const auto& value = (c.*section).*field;
+            return value ? YAML::Node(*value) : YAML::Node(YAML::NodeType::Null);
+          }};
+}
+
+template <typename Section>
+KeySpec integer_key(std::string path, SectionOf<Section> section, Member<Section, int> field,
+                    int min, int max) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            int value = 0;
+            if (!v.IsScalar() || !YAML::convert<int>::decode(v, value)) {
+              fail(where, "expected a whole number");
+            }
+            if (value < min || value > max) {
+              fail(where, "value " + v.Scalar() + " is out of range (must be " +
+                              std::to_string(min) + " .. " + std::to_string(max) + ")");
+            }
+            (c.*section).*field = value;
+          },
+          [=](const Config& c) { return YAML::Node((c.*section).*field); }};
+}
+
+template <typename Section>
+KeySpec bool_key(std::string path, SectionOf<Section> section, Member<Section, bool> field) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            bool value = false;
+            if (!v.IsScalar() || !YAML::convert<bool>::decode(v, value)) {
+              fail(where, "expected true or false");
+            }
+            (c.*section).*field = value;
+          },
+          [=](const Config& c) { return YAML::Node((c.*section).*field); }};
+}
+
+template <typename Section>
+KeySpec vec3_key(std::string path, SectionOf<Section> section,
+                 Member<Section, std::array<double, 3>> field, Range range) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            if (!v.IsSequence() || v.size() != 3) fail(where, "expected a list of 3 numbers");
+            std::array<double, 3> value{};
+            for (size_t i = 0; i < 3; ++i) {
+              value[i] = parse_number(v[i], where + "[" + std::to_string(i) + "]", range);
+            }
+            (c.*section).*field = value;
+          },
+          [=](const Config& c) {
+            YAML::Node node(YAML::NodeType::Sequence);
+            for (double x : (c.*section).*field) node.push_back(x);
+            node.SetStyle(YAML::EmitterStyle::Flow);
+            return node;
+          }};
+}
+
+std::string scalar_choice(const YAML::Node& v, const std::string& where,
+                          const std::vector<std::string>& choices) {
+  if (!v.IsScalar()) fail(where, "expected one of the names listed in default.yaml");
+  for (const auto& choice : choices) {
+    if (v.Scalar() == choice) return choice;
+  }
+  std::string message = "unknown value '" + v.Scalar() + "'";
+  const std::string hint = closest_match(v.Scalar(), choices);
+  if (!hint.empty()) message += " (did you mean '" + hint + "'?)";
+  message += "; choose one of:";
+  for (const auto& choice : choices) message += " " + choice;
+  fail(where, message);
+}
+
+KeySpec preset_key() {
+  return {"sensor.preset",
+          [](Config& c, const YAML::Node& v, const std::string& where) {
+            std::vector<std::string> choices = {"auto"};
+            for (const auto& name : sensor_preset_names()) choices.push_back(name);
+            c.sensor.preset = scalar_choice(v, where, choices);
+          },
+          [](const Config& c) { return YAML::Node(c.sensor.preset); }};
+}
+
+KeySpec backend_key() {
+  return {"map.backend",
+          [](Config& c, const YAML::Node& v, const std::string& where) {
+            const std::string name = scalar_choice(v, where, {"auto", "cuda", "cpu"});
+            c.map.backend = name == "cuda"  ? Backend::kCuda
+                            : name == "cpu" ? Backend::kCpu
+                                            : Backend::kAuto;
+          },
+          [](const Config& c) { return YAML::Node(to_string(c.map.backend)); }};
+}
+
+std::vector<KeySpec> make_specs() {
+  return {
+      preset_key(),
+      optional_number_key("sensor.min_range", &Config::sensor, &SensorConfig::min_range_m,
+                          {0.0, 1000.0}),
+      optional_number_key("sensor.max_range", &Config::sensor, &SensorConfig::max_range_m,
+                          {0.0, 10000.0, true}),
+      number_key("map.voxel_size", &Config::map, &MapConfig::voxel_size_m, {0.005, 2.0}),
+      number_key("map.truncation", &Config::map, &MapConfig::truncation_m, {0.0, 10.0, true}),
+      number_key("map.max_weight", &Config::map, &MapConfig::max_weight, {1.0, 500.0}),
+      vec3_key("map.size", &Config::map, &MapConfig::size_m, {1.0, 2000.0}),
+      number_key("map.shift_threshold", &Config::map, &MapConfig::shift_threshold_m,
+                 {0.0, 1000.0, true}),
+      backend_key(),
+      integer_key("odometry.optimization_steps", &Config::odometry,
+                  &OdometryConfig::optimization_steps, 1, 20),
+      bool_key("odometry.intensity_fusion", &Config::odometry, &OdometryConfig::intensity_fusion),
+      bool_key("odometry.deskew", &Config::odometry, &OdometryConfig::deskew),
+      bool_key("refine.enabled", &Config::refine, &RefineConfig::enabled),
+      number_key("refine.distance", &Config::refine, &RefineConfig::distance_m,
+                 {0.0, 10000.0, true}),
+  };
+}
+
+}  // namespace
+
+const std::vector<KeySpec>& key_specs() {
+  static const std::vector<KeySpec> specs = make_specs();
+  return specs;
+}
+
+void validate_relations(const Config& c) {
+  if (c.sensor.min_range_m && c.sensor.max_range_m &&
+      *c.sensor.min_range_m >= *c.sensor.max_range_m) {
+    throw ConfigError("sensor.min_range (" + std::to_string(*c.sensor.min_range_m) +
+                      " m) must be below sensor.max_range (" +
+                      std::to_string(*c.sensor.max_range_m) + " m)");
+  }
+  if (c.map.truncation_m < c.map.voxel_size_m) {
+    throw ConfigError("map.truncation (" + std::to_string(c.map.truncation_m) +
+                      " m) must be at least one voxel (map.voxel_size = " +
+                      std::to_string(c.map.voxel_size_m) + " m)");
+  }
+  double voxels = 1.0;
+  for (double extent : c.map.size_m) {
+    const double cells = std::ceil(extent / c.map.voxel_size_m);
+    if (cells < 3) {
+      throw ConfigError("map.size: every extent must span at least 3 voxels of map.voxel_size");
+    }
+    voxels *= cells;
+  }
+  // Voxel indices are 32-bit on the GPU; a map beyond that would not fit in memory anyway.
+  if (voxels > static_cast<double>(std::numeric_limits<int32_t>::max())) {
+    std::ostringstream s;
+    s << "map.size / map.voxel_size give " << voxels
+      << " voxels, more than the 2^31 a local map may hold; use a smaller map or larger voxels";
+    throw ConfigError(s.str());
+  }
+  const double half_smallest = 0.5 * std::min(c.map.size_m[0], c.map.size_m[1]);
+  if (c.map.shift_threshold_m > half_smallest) {
+    throw ConfigError("map.shift_threshold (" + std::to_string(c.map.shift_threshold_m) +
+                      " m) must be at most half the smallest horizontal extent of map.size (" +
+                      std::to_string(half_smallest) + " m)");
+  }
+}
+
+}  // namespace featsense::config::detail

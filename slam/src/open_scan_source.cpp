@@ -1,0 +1,120 @@
+// Format detection and the range limits every source gets.
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string_view>
+
+#include "featsense/config/config_error.hpp"
+#include "featsense/slam/io/readers.hpp"
+#include "featsense/slam/scan_source.hpp"
+
+namespace featsense::slam {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Drops returns outside [min, max] metres and any non-finite point, whatever the reader.
+class RangeLimitedSource final : public ScanSource {
+ public:
+  RangeLimitedSource(std::unique_ptr<ScanSource> inner, double min_m, double max_m)
+      : inner_(std::move(inner)), min_m_(min_m), max_m_(max_m) {}
+
+  std::optional<Scan> next() override {
+    std::optional<Scan> scan = inner_->next();
+    if (!scan) return scan;
+    for (size_t i = 0; i < scan->size(); ++i) {
+      if (!scan->valid[i]) continue;
+      const Eigen::Vector3f& p = scan->xyz[i];
+      const float r = p.norm();
+      if (!std::isfinite(r) || r < min_m_ || r > max_m_ || r == 0.0f) scan->invalidate(i);
+    }
+    return scan;
+  }
+  const SourceInfo& info() const override { return inner_->info(); }
+  const ReadStats& stats() const override { return inner_->stats(); }
+
+ private:
+  std::unique_ptr<ScanSource> inner_;
+  float min_m_;
+  float max_m_;
+};
+
+bool starts_with(std::string_view text, std::string_view prefix) {
+  return text.substr(0, prefix.size()) == prefix;
+}
+
+bool looks_like_pcd(std::string_view head) {
+  if (!(starts_with(head, "#") || starts_with(head, "VERSION") || starts_with(head, "FIELDS"))) {
+    return false;
+  }
+  return head.find("FIELDS") != std::string_view::npos;
+}
+
+std::unique_ptr<ScanSource> open_by_content(const std::string& input,
+                                            const SourceOptions& options) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(input, ec);
+  if (ec || !fs::exists(status)) throw InputError(input + ": no such file or folder");
+  if (fs::is_directory(status)) return open_scan_folder(input, options);
+  if (!fs::is_regular_file(status)) throw InputError(input + ": not a regular file");
+
+  std::ifstream file(input, std::ios::binary);
+  if (!file) throw InputError(input + ": cannot open (permission denied?)");
+  std::string head(1024, '\0');
+  file.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(file.gcount()));
+  if (head.empty()) throw InputError(input + ": empty file");
+
+  if (head.size() >= 4) {
+    uint32_t magic = 0;
+    std::memcpy(&magic, head.data(), 4);
+    if (magic == 0xa1b2c3d4u || magic == 0xd4c3b2a1u || magic == 0xa1b23c4du ||
+        magic == 0x4d3cb2a1u) {
+      return open_ouster_pcap(input, options);
+    }
+    if (magic == 0x0a0d0d0au) {
+      throw InputError(input +
+                       ": a pcapng capture; save it as classic pcap (editcap -F pcap IN OUT)");
+    }
+  }
+  if (starts_with(head, "#ROSBAG V2.0")) return open_rosbag(input, options);
+  if (starts_with(head, "#ROSBAG")) {
+    throw InputError(input + ": only ROS bag format 2.0 is supported (ROS 1 bags)");
+  }
+  if (starts_with(head, "ply\n") || starts_with(head, "ply\r\n")) {
+    return open_ply_file(input, options);
+  }
+  if (looks_like_pcd(head)) return open_pcd_file(input, options);
+  if (fs::path(input).extension() == ".bin") {
+    throw InputError(input + ": a single KITTI .bin; pass the folder that holds the scans");
+  }
+  throw InputError(input +
+                   ": unrecognised format (expected an Ouster pcap, a ROS1 bag, a PCD or PLY "
+                   "file, or a folder of scans)");
+}
+
+}  // namespace
+
+config::SensorModel sensor_for(const SourceOptions& options, const std::string& fallback_preset) {
+  const std::string name = options.sensor_preset == "auto" ? fallback_preset
+                                                           : options.sensor_preset;
+  try {
+    return config::sensor_preset(name);
+  } catch (const config::ConfigError& e) {
+    throw InputError(std::string("sensor.preset: ") + e.what());
+  }
+}
+
+std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
+                                             const SourceOptions& options) {
+  std::unique_ptr<ScanSource> source = open_by_content(input, options);
+  const config::SensorModel& sensor = source->info().sensor;
+  const double min_m = options.min_range_m.value_or(sensor.min_range_m);
+  const double max_m = options.max_range_m.value_or(sensor.max_range_m > 0.0 ? sensor.max_range_m
+                                                                             : 1.0e9);
+  return std::make_unique<RangeLimitedSource>(std::move(source), min_m, max_m);
+}
+
+}  // namespace featsense::slam
