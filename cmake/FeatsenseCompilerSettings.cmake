@@ -18,7 +18,7 @@ function(featsense_warnings target)
   target_compile_options(${target} PRIVATE
     $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
       -Wold-style-cast -Wcast-align -Wunused -Woverloaded-virtual -Wnull-dereference
-      -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough -Werror>
+      -Wformat=2 -Wimplicit-fallthrough -Werror>
     $<$<COMPILE_LANGUAGE:CUDA>:-Werror=all-warnings -Xcompiler=-Wall,-Wextra,-Werror>)
 endfunction()
 

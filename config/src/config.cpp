@@ -28,9 +28,10 @@ std::set<std::string> section_names() {
   return sections;
 }
 
-[[noreturn]] void unknown_key(const std::string& path, const std::string& where) {
+[[noreturn]] void unknown_key(const std::string& path, const std::string& where,
+                              const std::vector<std::string>& candidates = config_keys()) {
   std::string message = where + ": unknown config key '" + path + "'";
-  const std::string hint = closest_match(path, config_keys());
+  const std::string hint = closest_match(path, candidates);
   if (!hint.empty()) message += " (did you mean '" + hint + "'?)";
   throw ConfigError(message);
 }
@@ -48,7 +49,8 @@ void apply_document(Config& config, const YAML::Node& root, const std::string& o
   for (const auto& section : root) {
     const std::string section_name = section.first.as<std::string>();
     if (sections.count(section_name) == 0) {
-      unknown_key(section_name, location(origin, section.first));
+      unknown_key(section_name, location(origin, section.first),
+                  std::vector<std::string>(sections.begin(), sections.end()));
     }
     if (section.second.IsNull()) continue;
     if (!section.second.IsMap()) {

@@ -1,0 +1,24 @@
+#pragma once
+// Each subcommand registers itself on the top-level app and returns the work to run once
+// the command line is parsed (so that logging is set up and errors are reported in one place).
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <vector>
+
+#include "cli_context.hpp"
+
+namespace featsense::app {
+
+struct Command {
+  CLI::App* parser;
+  std::function<void()> run;
+};
+
+/// `featsense info INPUT`: what a recording holds.
+Command register_info(CLI::App& app, const CliContext& context);
+/// `featsense convert INPUT -o DIR`: one file per frame.
+Command register_convert(CLI::App& app, const CliContext& context);
+
+}  // namespace featsense::app

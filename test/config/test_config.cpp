@@ -1,0 +1,154 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "featsense/config/config.hpp"
+#include "featsense/config/config_error.hpp"
+
+namespace featsense::config {
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream file(path);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+const std::string kDefaultYaml = std::string(FEATSENSE_SOURCE_DIR) + "/config/default.yaml";
+
+/// The message of the ConfigError that `f` throws ("" when it throws none).
+template <typename F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, DefaultYamlDocumentsExactlyTheBuiltInDefaults) {
+  const Config from_file = load_config(kDefaultYaml);
+  EXPECT_EQ(to_yaml(from_file), to_yaml(Config{}));
+  // Every key of the schema is documented in default.yaml.
+  const std::string text = read_file(kDefaultYaml);
+  for (const std::string& key : config_keys()) {
+    const std::string leaf = key.substr(key.find('.') + 1);
+    EXPECT_NE(text.find("  " + leaf + ":"), std::string::npos) << key;
+  }
+}
+
+TEST(Config, DefaultsAreThoseOfTheDesign) {
+  const Config c;
+  EXPECT_DOUBLE_EQ(c.map.voxel_size_m, 0.064);
+  EXPECT_EQ(c.map.size_m, (std::array<double, 3>{40, 40, 15}));
+  EXPECT_EQ(c.map.backend, Backend::kAuto);
+  EXPECT_EQ(c.sensor.preset, "auto");
+  EXPECT_FALSE(c.sensor.min_range_m.has_value());
+}
+
+TEST(Config, ToYamlRoundTrips) {
+  const Config changed = load_config_text(
+      "map: {voxel_size: 0.05, size: [20, 30, 10], backend: cpu}\n"
+      "sensor: {preset: vlp16, max_range: 80}\nodometry: {deskew: false}\n",
+      "test");
+  const Config again = load_config_text(to_yaml(changed), "round trip");
+  EXPECT_EQ(to_yaml(again), to_yaml(changed));
+  EXPECT_DOUBLE_EQ(again.map.voxel_size_m, 0.05);
+  EXPECT_EQ(again.map.backend, Backend::kCpu);
+  EXPECT_EQ(again.sensor.preset, "vlp16");
+  EXPECT_DOUBLE_EQ(again.sensor.max_range_m.value(), 80.0);
+  EXPECT_FALSE(again.odometry.deskew);
+}
+
+TEST(Config, OverridesApplyInOrderAfterTheFile) {
+  const Config c = load_config_text("map: {voxel_size: 0.1}\n", "file",
+                                    {"map.voxel_size=0.08", "map.size=[10,12,5]",
+                                     "odometry.optimization_steps=5", "map.voxel_size=0.07"});
+  EXPECT_DOUBLE_EQ(c.map.voxel_size_m, 0.07);
+  EXPECT_EQ(c.map.size_m, (std::array<double, 3>{10, 12, 5}));
+  EXPECT_EQ(c.odometry.optimization_steps, 5);
+}
+
+TEST(Config, UnknownKeyNamesItAndSuggestsTheClosest) {
+  const std::string file_error =
+      error_of([] { load_config_text("map:\n  voxelsize: 0.1\n", "my.yaml"); });
+  EXPECT_NE(file_error.find("my.yaml:2"), std::string::npos) << file_error;
+  EXPECT_NE(file_error.find("map.voxelsize"), std::string::npos) << file_error;
+  EXPECT_NE(file_error.find("did you mean 'map.voxel_size'"), std::string::npos) << file_error;
+
+  const std::string set_error = error_of([] { load_config({}, {"map.trunaction=0.3"}); });
+  EXPECT_NE(set_error.find("did you mean 'map.truncation'"), std::string::npos) << set_error;
+
+  const std::string section_error = error_of([] { load_config_text("mapp: {}\n", "f"); });
+  EXPECT_NE(section_error.find("did you mean 'map'"), std::string::npos) << section_error;
+}
+
+TEST(Config, WrongTypesAreErrorsNamingTheKey) {
+  for (const auto& [assignment, key] : std::vector<std::pair<std::string, std::string>>{
+           {"map.voxel_size=fast", "map.voxel_size"},
+           {"map.size=[1,2]", "map.size"},
+           {"map.size=12", "map.size"},
+           {"odometry.deskew=maybe", "odometry.deskew"},
+           {"odometry.optimization_steps=2.5", "odometry.optimization_steps"},
+           {"map.backend=gpu", "map.backend"},
+           {"sensor.preset=os1-129", "sensor.preset"},
+           {"map.voxel_size=.nan", "map.voxel_size"},
+       }) {
+    const std::string message = error_of([&] { load_config({}, {assignment}); });
+    EXPECT_NE(message.find(key), std::string::npos) << assignment << " -> '" << message << "'";
+  }
+  EXPECT_NE(
+      error_of([] { load_config({}, {"sensor.preset=os1-12"}); }).find("did you mean 'os1-128'"),
+      std::string::npos);
+}
+
+TEST(Config, AbsurdValuesAreRejected) {
+  for (const char* assignment :
+       {"map.voxel_size=0", "map.voxel_size=-1", "map.voxel_size=100", "map.truncation=0",
+        "map.max_weight=0", "map.size=[40,40,-1]", "map.shift_threshold=0",
+        "odometry.optimization_steps=0", "sensor.min_range=-1", "sensor.max_range=0",
+        "refine.distance=-2"}) {
+    EXPECT_FALSE(error_of([&] { load_config({}, {assignment}); }).empty()) << assignment;
+  }
+}
+
+TEST(Config, RelationsBetweenKeysAreChecked) {
+  EXPECT_NE(error_of([] { load_config({}, {"map.truncation=0.01"}); }).find("at least one voxel"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              load_config({}, {"sensor.min_range=5", "sensor.max_range=2"});
+            }).find("sensor.min_range"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              load_config({}, {"map.voxel_size=0.005", "map.size=[2000,2000,100]"});
+            }).find("voxels"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { load_config({}, {"map.shift_threshold=30"}); }).find("shift_threshold"),
+            std::string::npos);
+}
+
+TEST(Config, NullRangeMeansTheSensorsOwn) {
+  const Config c = load_config({}, {"sensor.max_range=50", "sensor.max_range=null"});
+  EXPECT_FALSE(c.sensor.max_range_m.has_value());
+}
+
+TEST(Config, BadFilesGiveClearErrors) {
+  EXPECT_NE(
+      error_of([] { load_config(std::string("/nonexistent/featsense.yaml")); }).find("cannot open"),
+      std::string::npos);
+  EXPECT_NE(error_of([] { load_config_text("map: [1, 2\n", "broken.yaml"); }).find("broken.yaml"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { load_config_text("- 1\n- 2\n", "list.yaml"); }).find("mapping"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { load_config_text("map: 3\n", "scalar.yaml"); }).find("map"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { load_config({}, {"voxel_size"}); }).find("key=value"), std::string::npos);
+  // An empty file is a valid config: all defaults.
+  EXPECT_EQ(to_yaml(load_config_text("", "empty.yaml")), to_yaml(Config{}));
+}
+
+}  // namespace
+}  // namespace featsense::config
