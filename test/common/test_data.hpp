@@ -18,7 +18,8 @@ inline std::filesystem::path shared_data_dir() {
 
 /// A scratch folder for one test, emptied first.
 inline std::filesystem::path scratch_dir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "featsense-test" / name;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "featsense-test" / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -28,8 +29,8 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
 
 /// Skips the test (with a message) where ../shared/data/<relative> does not exist, else sets
 /// `var` to its full path.
-#define FEATSENSE_SHARED_FILE(var, relative)                                             \
-  const std::filesystem::path var = ::featsense::test::shared_data_dir() / (relative);   \
-  if (::featsense::test::shared_data_dir().empty() || !std::filesystem::exists(var)) {   \
+#define FEATSENSE_SHARED_FILE(var, relative)                                               \
+  const std::filesystem::path var = ::featsense::test::shared_data_dir() / (relative);     \
+  if (::featsense::test::shared_data_dir().empty() || !std::filesystem::exists(var)) {     \
     GTEST_SKIP() << "shared recording " << (relative) << " not found beside the checkout"; \
   }

@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/run_command.hpp"
+#include "common/test_data.hpp"
+
+namespace featsense::test {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  return nlohmann::json::parse(file);
+}
+
+TEST(Cli, VersionAndHelpOnEveryLevel) {
+  const CommandResult version = run_featsense("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.output.find("featsense "), std::string::npos);
+  for (const std::string& level : {"", "info ", "convert "}) {
+    const CommandResult help = run_featsense(level + "--help");
+    EXPECT_EQ(help.exit_code, 0) << level;
+    EXPECT_NE(help.output.find("--quiet"), std::string::npos) << level << help.output;
+  }
+}
+
+TEST(Cli, InfoOnTheBuiltInExampleReportsItsShape) {
+  const auto dir = scratch_dir("cli_info");
+  const CommandResult r = run_featsense("info --quiet --json " + (dir / "info.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("128 x 1024"), std::string::npos) << r.output;
+  const nlohmann::json info = read_json(dir / "info.json");
+  EXPECT_EQ(info["format"], "builtin-box-room");
+  EXPECT_EQ(info["frames"], 10);
+  EXPECT_EQ(info["rows"], 128);
+  EXPECT_EQ(info["cols"], 1024);
+  EXPECT_EQ(info["valid_points"]["min"], 128 * 1024);
+  EXPECT_EQ(info["valid_points"]["median"], 128 * 1024);
+  EXPECT_NEAR(info["time_span_s"].get<double>(), 0.9, 1e-6);
+}
+
+TEST(Cli, RangeLimitsFromTheConfigDropPoints) {
+  // The box room is 20 x 20 x 4 m: a 3 m limit keeps only the floor and ceiling near the sensor.
+  const CommandResult r = run_featsense("info --quiet --set sensor.max_range=3 --json -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json info = nlohmann::json::parse(r.output);
+  EXPECT_LT(info["valid_points"]["max"].get<double>(), 0.6 * 128 * 1024);
+  EXPECT_GT(info["valid_points"]["min"].get<double>(), 0.0);
+}
+
+TEST(Cli, ConfigErrorsNameTheKeyAndExitWithTwo) {
+  const CommandResult typo = run_featsense("info --set map.voxelsize=0.1");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.output.find("did you mean 'map.voxel_size'"), std::string::npos) << typo.output;
+  const CommandResult range = run_featsense("info --set map.voxel_size=-1");
+  EXPECT_EQ(range.exit_code, 2);
+  EXPECT_NE(range.output.find("map.voxel_size"), std::string::npos) << range.output;
+  const auto dir = scratch_dir("cli_config");
+  std::ofstream(dir / "bad.yaml") << "map:\n  truncation: far\n";
+  const CommandResult file = run_featsense("info --config " + (dir / "bad.yaml").string());
+  EXPECT_EQ(file.exit_code, 2);
+  EXPECT_NE(file.output.find("bad.yaml:2"), std::string::npos) << file.output;
+}
+
+TEST(Cli, UnknownSubcommandGetsAHint) {
+  const CommandResult r = run_featsense("inof");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("did you mean 'info'"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadInputsGiveOneClearError) {
+  const auto dir = scratch_dir("cli_bad_input");
+  std::ofstream(dir / "empty.pcd").close();
+  std::ofstream(dir / "noise.dat") << "this is not a recording\n";
+  for (const auto& [input, expected] : std::vector<std::pair<std::string, std::string>>{
+           {(dir / "missing.pcap").string(), "no such file"},
+           {(dir / "empty.pcd").string(), "empty file"},
+           {(dir / "noise.dat").string(), "unrecognised format"}}) {
+    const CommandResult r = run_featsense("info " + input);
+    EXPECT_EQ(r.exit_code, 1) << input;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("featsense: error:"), std::string::npos) << r.output;
+  }
+}
+
+TEST(Cli, ConvertedFramesReadBackAsTheSameRecording) {
+  const auto dir = scratch_dir("cli_convert");
+  FEATSENSE_SHARED_FILE(pcd, "velodyne/vlp16_1673400472138016708.pcd");
+  const CommandResult to_pcd =
+      run_featsense("convert --quiet " + pcd.string() + " -o " + (dir / "pcd").string());
+  ASSERT_EQ(to_pcd.exit_code, 0) << to_pcd.output;
+  const CommandResult original = run_featsense("info --quiet --json - " + pcd.string());
+  const CommandResult converted = run_featsense("info --quiet --json - " + (dir / "pcd").string());
+  ASSERT_EQ(original.exit_code, 0) << original.output;
+  ASSERT_EQ(converted.exit_code, 0) << converted.output;
+  const nlohmann::json a = nlohmann::json::parse(original.output);
+  const nlohmann::json b = nlohmann::json::parse(converted.output);
+  EXPECT_EQ(a["rows"], b["rows"]);
+  EXPECT_EQ(a["cols"], b["cols"]);
+  EXPECT_EQ(a["valid_points"], b["valid_points"]);
+  EXPECT_EQ(a["first_stamp_ns"], b["first_stamp_ns"]);
+}
+
+}  // namespace
+}  // namespace featsense::test
