@@ -20,5 +20,7 @@ struct Command {
 Command register_info(CLI::App& app, const CliContext& context);
 /// `featsense convert INPUT -o DIR`: one file per frame.
 Command register_convert(CLI::App& app, const CliContext& context);
+/// `featsense bench tsdf ...`: speed figures as JSON.
+Command register_bench(CLI::App& app, const CliContext& context);
 
 }  // namespace featsense::app

@@ -1,0 +1,23 @@
+#pragma once
+// Per-stage timings in milliseconds and their summary (median / p95 / max), as every
+// report and benchmark prints them.
+
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+namespace featsense::app {
+
+struct TimingSummary {
+  size_t count = 0;
+  double median_ms = 0.0;
+  double p95_ms = 0.0;
+  double max_ms = 0.0;
+  double mean_ms = 0.0;
+};
+
+/// Summary of samples in milliseconds (p95 by the nearest-rank method).
+TimingSummary summarize_ms(std::vector<double> samples_ms);
+nlohmann::json to_json(const TimingSummary& summary);
+
+}  // namespace featsense::app

@@ -1,0 +1,270 @@
+// The CUDA integrator: the same rule as the CPU reference (voxel.hpp, ray_marcher.hpp) in
+// four kernels per scan: keep one end point per voxel, the per-scan minimum (atomicMin on
+// the ordered candidate keys), fusion of the touched voxels, and their reset.
+
+#include <cuda_runtime.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "cuda_check.hpp"
+#include "device_buffer.hpp"
+#include "featsense/tsdf/integrator.hpp"
+#include "ray_marcher.hpp"
+
+namespace featsense::tsdf {
+namespace {
+
+constexpr int kThreads = 256;
+
+unsigned int blocks_for(size_t n) {
+  return static_cast<unsigned int>((n + kThreads - 1) / kThreads);
+}
+
+/// Phase 1 of the reduction: per voxel of the local map, the smallest index of an end point.
+__global__ void mark_first_point_kernel(const Vec3* endpoints, uint32_t n, LocalMapGeometry map,
+                                        uint32_t* candidates) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Index3 v = map.voxel_of(endpoints[i]);
+  if (map.contains(v)) atomicMin(&candidates[map.linear(v)], i);
+}
+
+/// Phase 2: the rays to march (the first point of each voxel, every point outside the map),
+/// and the voxels' slots reset for the candidates.
+__global__ void select_rays_kernel(const Vec3* endpoints, uint32_t n, LocalMapGeometry map,
+                                   uint32_t* candidates, uint32_t* kept, uint32_t* kept_count) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Index3 v = map.voxel_of(endpoints[i]);
+  bool keep = true;
+  if (map.contains(v)) {
+    uint32_t* slot = &candidates[map.linear(v)];
+    keep = *slot == i;
+    // The winner resets the slot at once: a loser reading it afterwards sees
+    // kEmptyCandidate, which is no point index, so it still loses.
+    if (keep) *slot = kEmptyCandidate;
+  }
+  if (keep) kept[atomicAdd(kept_count, 1u)] = i;
+}
+
+struct ProposeCandidate {
+  LocalMapGeometry map;
+  uint32_t* candidates;
+  uint32_t* touched;
+  uint32_t* touched_count;
+  uint32_t touched_capacity;
+
+  __device__ void operator()(Index3 voxel, int32_t value, bool interpolated) const {
+    const size_t index = map.linear(voxel);
+    const uint32_t key = make_candidate(value, interpolated);
+    // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
+    if (candidates[index] <= key) return;
+    if (atomicMin(&candidates[index], key) == kEmptyCandidate) {
+      const uint32_t slot = atomicAdd(touched_count, 1u);
+      if (slot < touched_capacity) touched[slot] = static_cast<uint32_t>(index);
+    }
+  }
+};
+
+__global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
+                                const uint32_t* kept, const uint32_t* kept_count,
+                                detail::RayMarchParams params, ProposeCandidate propose) {
+  const uint32_t count = *kept_count;
+  for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
+    const uint32_t i = kept[k];
+    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, params,
+                      propose);
+  }
+}
+
+__device__ void fuse_voxel(size_t index, uint32_t* candidates, uint32_t* map, int32_t falloff,
+                           uint32_t max_weight) {
+  const uint32_t key = candidates[index];
+  candidates[index] = kEmptyCandidate;
+  const int32_t value = candidate_value(key);
+  map[index] = pack(fuse(unpack(map[index]), value, candidate_weight(value, falloff), max_weight));
+}
+
+__global__ void fuse_touched_kernel(const uint32_t* touched, const uint32_t* touched_count,
+                                    uint32_t capacity, uint32_t* candidates, uint32_t* map,
+                                    int32_t falloff, uint32_t max_weight) {
+  const uint32_t count = *touched_count;
+  if (count > capacity) return;  // the list overflowed: fuse_all_kernel sweeps instead
+  for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
+    fuse_voxel(touched[k], candidates, map, falloff, max_weight);
+  }
+}
+
+/// When a scan touched more voxels than the list holds: fuse every voxel with a candidate.
+__global__ void fuse_all_kernel(size_t voxel_count, uint32_t* candidates, uint32_t* map,
+                                int32_t falloff, uint32_t max_weight) {
+  const size_t index = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (index >= voxel_count || candidates[index] == kEmptyCandidate) return;
+  fuse_voxel(index, candidates, map, falloff, max_weight);
+}
+
+class CudaIntegrator final : public Integrator {
+ public:
+  CudaIntegrator(const TsdfSettings& settings, Vec3 centre_m)
+      : settings_(settings), geometry_(centred_geometry(settings, centre_m)) {
+    const size_t n = geometry_.voxel_count();
+    FEATSENSE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+    int device = 0;
+    int multiprocessors = 0;
+    FEATSENSE_CUDA_CHECK(cudaGetDevice(&device));
+    FEATSENSE_CUDA_CHECK(
+        cudaDeviceGetAttribute(&multiprocessors, cudaDevAttrMultiProcessorCount, device));
+    // Grid-stride kernels whose work count lives on the device get a grid that fills the GPU.
+    resident_blocks_ = static_cast<unsigned int>(multiprocessors) * 8u;
+    map_.reserve(n);
+    candidates_.reserve(n);
+    // A scan touches a small part of the map; a scan that touches more falls back to a sweep.
+    touched_capacity_ = static_cast<uint32_t>(std::min<size_t>(n, 32u << 20));
+    touched_.reserve(touched_capacity_);
+    counters_.reserve(2);
+    host_counters_.reserve(2);
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(map_.data(), 0, n * sizeof(uint32_t), stream_));
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(candidates_.data(), 0xFF, n * sizeof(uint32_t), stream_));
+    FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  }
+  ~CudaIntegrator() override { cudaStreamDestroy(stream_); }
+
+  std::string backend_name() const override { return "cuda"; }
+  const LocalMapGeometry& geometry() const override { return geometry_; }
+  size_t memory_bytes() const override {
+    return map_.bytes() + candidates_.bytes() + touched_.bytes() + kept_.bytes() +
+           endpoints_.bytes() + origins_.bytes() + counters_.bytes();
+  }
+
+  std::vector<uint32_t> download() const override {
+    std::vector<uint32_t> out(geometry_.voxel_count());
+    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(out.data(), map_.data(), out.size() * sizeof(uint32_t),
+                                         cudaMemcpyDeviceToHost, stream_));
+    FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    return out;
+  }
+
+  IntegrationStats integrate(const RayBatch& rays) override {
+    const uint32_t n = static_cast<uint32_t>(rays.size());
+    IntegrationStats stats;
+    if (n == 0) return stats;
+    const bool origin_per_point = rays.origins_m.size() > 1;
+    const size_t origin_count = origin_per_point ? n : 1;
+    upload(rays, origin_count);
+    uint32_t* kept_count = counters_.data();
+    uint32_t* touched_count = counters_.data() + 1;
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, 2 * sizeof(uint32_t), stream_));
+
+    kept_.reserve(n);
+    if (settings_.reduce_points_per_voxel) {
+      mark_first_point_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
+          endpoints_.data(), n, geometry_, candidates_.data());
+      select_rays_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
+          endpoints_.data(), n, geometry_, candidates_.data(), kept_.data(), kept_count);
+    } else {
+      fill_identity(n, kept_count);
+    }
+    FEATSENSE_CUDA_CHECK(cudaGetLastError());
+
+    detail::RayMarchParams params;
+    params.truncation_m = settings_.truncation_m;
+    params.interpolation_slope = settings_.interpolation_slope;
+    params.up = rays.up;
+    const ProposeCandidate propose{geometry_, candidates_.data(), touched_.data(), touched_count,
+                                   touched_capacity_};
+    min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(origins_.data(), origin_per_point,
+                                                             endpoints_.data(), kept_.data(),
+                                                             kept_count, params, propose);
+    FEATSENSE_CUDA_CHECK(cudaGetLastError());
+    const int32_t falloff = settings_.falloff_start_fixed();
+    const uint32_t max_weight = settings_.max_weight_fixed();
+    fuse_touched_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
+        touched_.data(), touched_count, touched_capacity_, candidates_.data(), map_.data(), falloff,
+        max_weight);
+    FEATSENSE_CUDA_CHECK(cudaGetLastError());
+    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
+                                         2 * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream_));
+    FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    stats.rays = host_counters_.data()[0];
+    stats.voxels_updated = host_counters_.data()[1];
+    if (stats.voxels_updated > touched_capacity_) {
+      fuse_all_kernel<<<blocks_for(geometry_.voxel_count()), kThreads, 0, stream_>>>(
+          geometry_.voxel_count(), candidates_.data(), map_.data(), falloff, max_weight);
+      FEATSENSE_CUDA_CHECK(cudaGetLastError());
+      FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    }
+    return stats;
+  }
+
+ private:
+  void upload(const RayBatch& rays, size_t origin_count) {
+    const size_t n = rays.size();
+    staging_.reserve(n + origin_count);
+    endpoints_.reserve(n);
+    origins_.reserve(origin_count);
+    std::memcpy(staging_.data(), rays.endpoints_m.data(), n * sizeof(Vec3));
+    std::memcpy(staging_.data() + n, rays.origins_m.data(), origin_count * sizeof(Vec3));
+    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(endpoints_.data(), staging_.data(), n * sizeof(Vec3),
+                                         cudaMemcpyHostToDevice, stream_));
+    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(origins_.data(), staging_.data() + n,
+                                         origin_count * sizeof(Vec3), cudaMemcpyHostToDevice,
+                                         stream_));
+  }
+
+  void fill_identity(uint32_t n, uint32_t* kept_count);
+
+  TsdfSettings settings_;
+  LocalMapGeometry geometry_;
+  cudaStream_t stream_ = nullptr;
+  cuda::DeviceBuffer<uint32_t> map_;
+  cuda::DeviceBuffer<uint32_t> candidates_;
+  cuda::DeviceBuffer<uint32_t> touched_;
+  uint32_t touched_capacity_ = 0;
+  unsigned int resident_blocks_ = 1;
+  cuda::DeviceBuffer<uint32_t> kept_;
+  cuda::DeviceBuffer<uint32_t> counters_;
+  cuda::PinnedBuffer<uint32_t> host_counters_;
+  cuda::DeviceBuffer<Vec3> endpoints_;
+  cuda::DeviceBuffer<Vec3> origins_;
+  cuda::PinnedBuffer<Vec3> staging_;
+};
+
+__global__ void identity_kernel(uint32_t* kept, uint32_t n, uint32_t* kept_count) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i == 0) *kept_count = n;
+  if (i < n) kept[i] = i;
+}
+
+void CudaIntegrator::fill_identity(uint32_t n, uint32_t* kept_count) {
+  identity_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(kept_.data(), n, kept_count);
+}
+
+}  // namespace
+
+bool cuda_backend_available(std::string* why) {
+  int count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess || count == 0) {
+    if (why) {
+      *why = status != cudaSuccess ? std::string("no usable GPU: ") + cudaGetErrorString(status)
+                                   : std::string("no GPU found");
+    }
+    return false;
+  }
+  cudaDeviceProp properties{};
+  if (cudaGetDeviceProperties(&properties, 0) == cudaSuccess && why) {
+    *why = std::string("GPU ") + properties.name;
+  }
+  return true;
+}
+
+std::unique_ptr<Integrator> make_cuda_integrator(const TsdfSettings& settings, Vec3 centre_m) {
+  std::string why;
+  if (!cuda_backend_available(&why))
+    throw std::runtime_error("the CUDA backend is unavailable: " + why);
+  return std::make_unique<CudaIntegrator>(settings, centre_m);
+}
+
+}  // namespace featsense::tsdf

@@ -1,0 +1,42 @@
+#pragma once
+/// What a TSDF integrator needs to know, in plain numbers (built from the config and the
+/// sensor model by from_config()).
+
+#include <array>
+#include <cstdint>
+
+#include "featsense/config/config.hpp"
+#include "featsense/config/sensor_model.hpp"
+#include "featsense/tsdf/local_map_geometry.hpp"
+
+namespace featsense::tsdf {
+
+struct TsdfSettings {
+  float voxel_size_m = 0.064f;
+  float truncation_m = 0.6f;
+  float max_weight = 10.0f;
+  std::array<float, 3> map_size_m = {40.0f, 40.0f, 15.0f};
+  /// tan of the vertical angle between two beams (vfov / beams, paper eq. 7); 0 = no
+  /// vertical interpolation.
+  float interpolation_slope = 0.0f;
+  /// Before ray marching, keep only the first end point (in scan order) of each voxel of
+  /// the local map; end points outside it are all kept. Rays to one voxel propose nearly
+  /// the same values, so this saves work at a loss below the voxel size.
+  bool reduce_points_per_voxel = true;
+
+  /// Voxels per axis: the size rounded up to whole voxels and to an odd count, so that the
+  /// sensor sits in the centre voxel.
+  Index3 map_dim() const;
+  /// The fixed-point weight cap (max_weight * kWeightScale).
+  uint32_t max_weight_fixed() const;
+  /// Where the weight of a scan starts to fall off behind the surface, fixed point (one voxel).
+  int32_t falloff_start_fixed() const;
+
+  /// Settings of config.map, interpolation from the sensor's vertical field of view and beams.
+  static TsdfSettings from_config(const config::MapConfig& map, const config::SensorModel& sensor);
+};
+
+/// The local map geometry of `settings`, centred on the voxel that holds `centre_m`.
+LocalMapGeometry centred_geometry(const TsdfSettings& settings, Vec3 centre_m);
+
+}  // namespace featsense::tsdf

@@ -1,0 +1,131 @@
+#pragma once
+// One ray's contribution to a scan's TSDF volume: a 3D DDA that visits every voxel the ray
+// crosses from where it enters the local map to tau behind its end point, with the
+// projective distance of each, and the vertical interpolation of the paper. Shared by the
+// CPU integrator and the CUDA kernel, so both propose exactly the same candidates.
+
+#include <cfloat>
+
+#include "featsense/tsdf/local_map_geometry.hpp"
+#include "featsense/tsdf/vec3.hpp"
+#include "featsense/tsdf/voxel.hpp"
+
+namespace featsense::tsdf::detail {
+
+struct RayMarchParams {
+  float truncation_m = 0.6f;
+  /// tan(vertical beam spacing): the half-height of the interpolation band per metre of
+  /// range (paper eq. 7-8); 0 turns interpolation off.
+  float interpolation_slope = 0.0f;
+  Vec3 up{0.0f, 0.0f, 1.0f};  ///< the sensor's z axis in the map frame
+};
+
+/// Clips the segment origin + t * dir, t in [t0, t1], to the box [lo, hi]; false if it misses.
+FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, float& t0,
+                                     float& t1) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const float o = component(origin, axis);
+    const float d = component(dir, axis);
+    const float a = component(lo, axis);
+    const float b = component(hi, axis);
+    if (d == 0.0f) {
+      if (o < a || o >= b) return false;
+      continue;
+    }
+    float ta = (a - o) / d;
+    float tb = (b - o) / d;
+    if (ta > tb) {
+      const float swap = ta;
+      ta = tb;
+      tb = swap;
+    }
+    if (ta > t0) t0 = ta;
+    if (tb < t1) t1 = tb;
+  }
+  return t0 < t1;
+}
+
+/// Calls visit(index, value_fixed, interpolated) for each candidate of the ray from `origin`
+/// to `endpoint` (map frame, metres). Voxels outside the local map are never visited.
+template <typename Visit>
+FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
+                                   const RayMarchParams& params, Visit&& visit) {
+  const Vec3 delta = endpoint - origin;
+  const float range = norm(delta);
+  if (!(range > 0.0f)) return;
+  const Vec3 dir = (1.0f / range) * delta;
+  float t0 = 0.0f;
+  float t1 = range + params.truncation_m;
+  if (!clip_to_box(origin, dir, map.min_corner(), map.max_corner(), t0, t1)) return;
+
+  // Interpolation direction: int = d x (d x up), in the plane of the ray and the sensor's up.
+  Vec3 across = cross(dir, cross(dir, params.up));
+  const float across_length = norm(across);
+  const bool interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
+  if (interpolate) across = (1.0f / across_length) * across;
+
+  // Amanatides & Woo traversal, starting in the voxel where the clipped ray begins.
+  const float vs = map.voxel_size_m;
+  Index3 voxel = map.voxel_of(origin + t0 * dir);
+  int32_t step[3];
+  float t_next[3];
+  float t_delta[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    const float d = component(dir, axis);
+    const float o = component(origin, axis);
+    const int32_t v = component(voxel, axis);
+    if (d > 0.0f) {
+      step[axis] = 1;
+      t_next[axis] = ((static_cast<float>(v) + 1.0f) * vs - o) / d;
+      t_delta[axis] = vs / d;
+    } else if (d < 0.0f) {
+      step[axis] = -1;
+      t_next[axis] = (static_cast<float>(v) * vs - o) / d;
+      t_delta[axis] = -vs / d;
+    } else {
+      step[axis] = 0;
+      t_next[axis] = FLT_MAX;
+      t_delta[axis] = FLT_MAX;
+    }
+  }
+
+  const float tau = params.truncation_m;
+  float t = t0;
+  // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
+  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
+  for (int32_t i = 0; i < max_steps && t <= t1; ++i) {
+    if (map.contains(voxel)) {
+      const Vec3 centre = map.centre_of(voxel);
+      const float along = dot(centre - origin, dir);
+      const float distance = range - along;
+      if (distance >= -tau) {
+        const int32_t value = distance_to_fixed(distance, tau);
+        visit(voxel, value, false);
+        // Fill between the scan lines only near the surface: free space far in front is
+        // carved by the rays themselves, and widening every ray there costs more than it gives.
+        if (interpolate && distance < tau) {
+          const float half_height = params.interpolation_slope * along;
+          const int32_t reach = static_cast<int32_t>(half_height / vs);
+          for (int32_t k = 1; k <= reach; ++k) {
+            const float offset = static_cast<float>(k) * vs;
+            const Index3 above = map.voxel_of(centre + offset * across);
+            const Index3 below = map.voxel_of(centre - offset * across);
+            if (map.contains(above)) visit(above, value, true);
+            if (map.contains(below)) visit(below, value, true);
+          }
+        }
+      }
+    }
+    // Step into the neighbour across the nearest voxel face.
+    int axis = 0;
+    if (t_next[1] < t_next[axis]) axis = 1;
+    if (t_next[2] < t_next[axis]) axis = 2;
+    t = t_next[axis];
+    t_next[axis] += t_delta[axis];
+    if (axis == 0) voxel.x += step[0];
+    if (axis == 1) voxel.y += step[1];
+    if (axis == 2) voxel.z += step[2];
+  }
+}
+
+}  // namespace featsense::tsdf::detail

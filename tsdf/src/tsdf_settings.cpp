@@ -1,0 +1,52 @@
+#include "featsense/tsdf/tsdf_settings.hpp"
+
+#include <cmath>
+
+#include "featsense/tsdf/voxel.hpp"
+
+namespace featsense::tsdf {
+
+Index3 TsdfSettings::map_dim() const {
+  int32_t dim[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    int32_t n =
+        static_cast<int32_t>(std::ceil(map_size_m[static_cast<size_t>(axis)] / voxel_size_m));
+    if (n % 2 == 0) ++n;
+    dim[axis] = n;
+  }
+  return {dim[0], dim[1], dim[2]};
+}
+
+uint32_t TsdfSettings::max_weight_fixed() const {
+  return static_cast<uint32_t>(std::lround(max_weight * static_cast<float>(kWeightScale)));
+}
+
+int32_t TsdfSettings::falloff_start_fixed() const {
+  return distance_to_fixed(voxel_size_m, truncation_m);
+}
+
+TsdfSettings TsdfSettings::from_config(const config::MapConfig& map,
+                                       const config::SensorModel& sensor) {
+  TsdfSettings s;
+  s.voxel_size_m = static_cast<float>(map.voxel_size_m);
+  s.truncation_m = static_cast<float>(map.truncation_m);
+  s.max_weight = static_cast<float>(map.max_weight);
+  for (size_t axis = 0; axis < 3; ++axis) s.map_size_m[axis] = static_cast<float>(map.size_m[axis]);
+  if (sensor.beams > 1) {
+    s.interpolation_slope =
+        static_cast<float>(std::tan(sensor.vertical_fov_rad() / static_cast<double>(sensor.beams)));
+  }
+  return s;
+}
+
+LocalMapGeometry centred_geometry(const TsdfSettings& settings, Vec3 centre_m) {
+  LocalMapGeometry g;
+  g.voxel_size_m = settings.voxel_size_m;
+  g.dim = settings.map_dim();
+  const Index3 centre = g.voxel_of(centre_m);
+  g.origin = {centre.x - (g.dim.x - 1) / 2, centre.y - (g.dim.y - 1) / 2,
+              centre.z - (g.dim.z - 1) / 2};
+  return g;
+}
+
+}  // namespace featsense::tsdf
