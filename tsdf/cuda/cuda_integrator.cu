@@ -56,8 +56,7 @@ struct ProposeCandidate {
   uint32_t* touched_count;
   uint32_t touched_capacity;
 
-  __device__ void operator()(Index3 voxel, int32_t value, bool interpolated) const {
-    const size_t index = map.linear(voxel);
+  __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
     const uint32_t key = make_candidate(value, interpolated);
     // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
     if (candidates[index] <= key) return;

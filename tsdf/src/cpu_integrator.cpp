@@ -52,8 +52,7 @@ class CpuIntegrator final : public Integrator {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, kept.size(), 64),
                       [&](const tbb::blocked_range<size_t>& range) {
                         std::vector<uint32_t>& touched = touched_.local();
-                        const auto propose = [&](Index3 voxel, int32_t value, bool interpolated) {
-                          const size_t index = geometry_.linear(voxel);
+                        const auto propose = [&](size_t index, int32_t value, bool interpolated) {
                           const uint32_t key = make_candidate(value, interpolated);
                           // Only the ray that first fills a slot lists it: each voxel fuses once.
                           if (atomic_min(candidates_[index], key) == kEmptyCandidate) {

@@ -45,7 +45,7 @@ FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, fl
   return t0 < t1;
 }
 
-/// Calls visit(index, value_fixed, interpolated) for each candidate of the ray from `origin`
+/// Calls visit(linear_index, value_fixed, interpolated) for each candidate of the ray from `origin`
 /// to `endpoint` (map frame, metres). Voxels outside the local map are never visited.
 template <typename Visit>
 FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
@@ -89,6 +89,11 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     }
   }
 
+  // Ring-buffer coordinates follow the traversal incrementally: no division per step.
+  int32_t wrapped[3] = {wrap_index(voxel.x, map.dim.x), wrap_index(voxel.y, map.dim.y),
+                        wrap_index(voxel.z, map.dim.z)};
+  const int32_t dims[3] = {map.dim.x, map.dim.y, map.dim.z};
+
   const float tau = params.truncation_m;
   float t = t0;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
@@ -100,7 +105,11 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
       const float distance = range - along;
       if (distance >= -tau) {
         const int32_t value = distance_to_fixed(distance, tau);
-        visit(voxel, value, false);
+        const size_t linear = static_cast<size_t>(wrapped[0]) +
+                              static_cast<size_t>(dims[0]) *
+                                  (static_cast<size_t>(wrapped[1]) +
+                                   static_cast<size_t>(dims[1]) * static_cast<size_t>(wrapped[2]));
+        visit(linear, value, false);
         // Fill between the scan lines only near the surface: free space far in front is
         // carved by the rays themselves, and widening every ray there costs more than it gives.
         if (interpolate && distance < tau) {
@@ -110,8 +119,8 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
             const float offset = static_cast<float>(k) * vs;
             const Index3 above = map.voxel_of(centre + offset * across);
             const Index3 below = map.voxel_of(centre - offset * across);
-            if (map.contains(above)) visit(above, value, true);
-            if (map.contains(below)) visit(below, value, true);
+            if (map.contains(above)) visit(map.linear(above), value, true);
+            if (map.contains(below)) visit(map.linear(below), value, true);
           }
         }
       }
@@ -125,6 +134,9 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     if (axis == 0) voxel.x += step[0];
     if (axis == 1) voxel.y += step[1];
     if (axis == 2) voxel.z += step[2];
+    wrapped[axis] += step[axis];
+    if (wrapped[axis] == dims[axis]) wrapped[axis] = 0;
+    if (wrapped[axis] < 0) wrapped[axis] = dims[axis] - 1;
   }
 }
 
