@@ -10,8 +10,8 @@ namespace {
 
 TEST(LocalMapGeometry, RingBufferLayoutIsABijectionWhereverTheMapIs) {
   LocalMapGeometry g;
-  g.dim = {5, 7, 3};
-  for (const Index3 origin : {Index3{0, 0, 0}, Index3{-13, 4, -2}, Index3{1000, -999, 77}}) {
+  g.dim = {3 * kBrickSize, 5 * kBrickSize, kBrickSize};
+  for (const Index3 origin : {Index3{0, 0, 0}, Index3{-16, 8, -24}, Index3{1000, -1000, 80}}) {
     g.origin = origin;
     std::vector<int> hits(g.voxel_count(), 0);
     for (int z = 0; z < g.dim.z; ++z) {
@@ -39,17 +39,40 @@ TEST(LocalMapGeometry, VoxelsAreAnchoredAtTheMapOrigin) {
   EXPECT_FLOAT_EQ(g.centre_of({-1, 0, 2}).z, 0.25f);
 }
 
-TEST(LocalMapGeometry, TheMapIsCentredOnTheSensorWithAnOddSize) {
+TEST(LocalMapGeometry, TheMapIsCentredOnTheSensorsBrickWithAnOddBrickCount) {
   TsdfSettings s;  // 40 x 40 x 15 m at 6.4 cm
   const Index3 dim = s.map_dim();
-  EXPECT_EQ(dim.x, 625);
-  EXPECT_EQ(dim.y, 625);
-  EXPECT_EQ(dim.z, 235);  // 234.4 rounded up, then to odd
-  const LocalMapGeometry g = centred_geometry(s, {3.0f, -2.0f, 1.0f});
-  const Index3 centre = g.voxel_of({3.0f, -2.0f, 1.0f});
-  EXPECT_EQ(centre.x - g.origin.x, (dim.x - 1) / 2);
-  EXPECT_EQ(g.origin.x + dim.x - 1 - centre.x, (dim.x - 1) / 2);
-  EXPECT_EQ(centre.z - g.origin.z, (dim.z - 1) / 2);
+  EXPECT_EQ(dim.x, 79 * kBrickSize);  // 625 voxels, 78.1 bricks, rounded up to 79 (odd)
+  EXPECT_EQ(dim.y, 79 * kBrickSize);
+  EXPECT_EQ(dim.z, 31 * kBrickSize);  // 235 voxels, 29.4 bricks, up to 30, then to odd
+  for (const Vec3 sensor : {Vec3{3.0f, -2.0f, 1.0f}, Vec3{-100.3f, 0.01f, -7.7f}}) {
+    const LocalMapGeometry g = centred_geometry(s, sensor);
+    const Index3 centre = g.voxel_of(sensor);
+    EXPECT_EQ(g.origin.x % kBrickSize, 0);
+    EXPECT_EQ(g.origin.z % kBrickSize, 0);
+    EXPECT_EQ(brick_of(centre.x) - brick_of(g.origin.x), (g.bricks().x - 1) / 2);
+    EXPECT_EQ(brick_of(g.origin.y + dim.y - 1) - brick_of(centre.y), (g.bricks().y - 1) / 2);
+    EXPECT_EQ(brick_of(centre.z) - brick_of(g.origin.z), (g.bricks().z - 1) / 2);
+  }
+}
+
+TEST(LocalMapGeometry, BricksHoldNeighbouringVoxelsTogether) {
+  LocalMapGeometry g;
+  g.dim = {3 * kBrickSize, 3 * kBrickSize, 3 * kBrickSize};
+  g.origin = {-8, -8, -8};
+  const size_t first = g.linear({0, 0, 0});
+  EXPECT_EQ(first % kBrickVoxels, 0u);
+  for (int32_t z = 0; z < kBrickSize; ++z) {
+    for (int32_t y = 0; y < kBrickSize; ++y) {
+      for (int32_t x = 0; x < kBrickSize; ++x) {
+        ASSERT_LT(g.linear({x, y, z}) - first, static_cast<size_t>(kBrickVoxels));
+      }
+    }
+  }
+  EXPECT_EQ(brick_of(-1), -1);
+  EXPECT_EQ(brick_of(-8), -1);
+  EXPECT_EQ(brick_of(-9), -2);
+  EXPECT_EQ(brick_of(7), 0);
 }
 
 }  // namespace

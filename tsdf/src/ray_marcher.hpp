@@ -89,10 +89,13 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     }
   }
 
-  // Ring-buffer coordinates follow the traversal incrementally: no division per step.
-  int32_t wrapped[3] = {wrap_index(voxel.x, map.dim.x), wrap_index(voxel.y, map.dim.y),
-                        wrap_index(voxel.z, map.dim.z)};
-  const int32_t dims[3] = {map.dim.x, map.dim.y, map.dim.z};
+  // Brick slot and place in the brick follow the traversal incrementally: no division per step.
+  const Index3 start_brick = map.wrapped_brick(voxel);
+  const Index3 start_local = LocalMapGeometry::local_in_brick(voxel);
+  int32_t brick[3] = {start_brick.x, start_brick.y, start_brick.z};
+  int32_t local[3] = {start_local.x, start_local.y, start_local.z};
+  const Index3 nb = map.bricks();
+  const int32_t bricks[3] = {nb.x, nb.y, nb.z};
 
   const float tau = params.truncation_m;
   float t = t0;
@@ -105,11 +108,8 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
       const float distance = range - along;
       if (distance >= -tau) {
         const int32_t value = distance_to_fixed(distance, tau);
-        const size_t linear = static_cast<size_t>(wrapped[0]) +
-                              static_cast<size_t>(dims[0]) *
-                                  (static_cast<size_t>(wrapped[1]) +
-                                   static_cast<size_t>(dims[1]) * static_cast<size_t>(wrapped[2]));
-        visit(linear, value, false);
+        visit(map.linear_from({brick[0], brick[1], brick[2]}, {local[0], local[1], local[2]}),
+              value, false);
         // Fill between the scan lines only near the surface: free space far in front is
         // carved by the rays themselves, and widening every ray there costs more than it gives.
         if (interpolate && distance < tau) {
@@ -134,9 +134,13 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     if (axis == 0) voxel.x += step[0];
     if (axis == 1) voxel.y += step[1];
     if (axis == 2) voxel.z += step[2];
-    wrapped[axis] += step[axis];
-    if (wrapped[axis] == dims[axis]) wrapped[axis] = 0;
-    if (wrapped[axis] < 0) wrapped[axis] = dims[axis] - 1;
+    local[axis] += step[axis];
+    if (local[axis] == kBrickSize || local[axis] < 0) {
+      local[axis] -= step[axis] * kBrickSize;
+      brick[axis] += step[axis];
+      if (brick[axis] == bricks[axis]) brick[axis] = 0;
+      if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+    }
   }
 }
 

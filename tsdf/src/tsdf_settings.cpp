@@ -9,10 +9,10 @@ namespace featsense::tsdf {
 Index3 TsdfSettings::map_dim() const {
   int32_t dim[3];
   for (int axis = 0; axis < 3; ++axis) {
-    int32_t n =
-        static_cast<int32_t>(std::ceil(map_size_m[static_cast<size_t>(axis)] / voxel_size_m));
-    if (n % 2 == 0) ++n;
-    dim[axis] = n;
+    const double voxels = std::ceil(map_size_m[static_cast<size_t>(axis)] / voxel_size_m);
+    int32_t bricks = static_cast<int32_t>(std::ceil(voxels / kBrickSize));
+    if (bricks % 2 == 0) ++bricks;
+    dim[axis] = bricks * kBrickSize;
   }
   return {dim[0], dim[1], dim[2]};
 }
@@ -44,8 +44,10 @@ LocalMapGeometry centred_geometry(const TsdfSettings& settings, Vec3 centre_m) {
   g.voxel_size_m = settings.voxel_size_m;
   g.dim = settings.map_dim();
   const Index3 centre = g.voxel_of(centre_m);
-  g.origin = {centre.x - (g.dim.x - 1) / 2, centre.y - (g.dim.y - 1) / 2,
-              centre.z - (g.dim.z - 1) / 2};
+  const Index3 nb = g.bricks();
+  g.origin = {(brick_of(centre.x) - (nb.x - 1) / 2) * kBrickSize,
+              (brick_of(centre.y) - (nb.y - 1) / 2) * kBrickSize,
+              (brick_of(centre.z) - (nb.z - 1) / 2) * kBrickSize};
   return g;
 }
 

@@ -24,8 +24,8 @@ struct TsdfSettings {
   /// the same values, so this saves work at a loss below the voxel size.
   bool reduce_points_per_voxel = true;
 
-  /// Voxels per axis: the size rounded up to whole voxels and to an odd count, so that the
-  /// sensor sits in the centre voxel.
+  /// Voxels per axis: the size rounded up to whole bricks and to an odd count of bricks, so
+  /// that the sensor sits in the centre brick.
   Index3 map_dim() const;
   /// The fixed-point weight cap (max_weight * kWeightScale).
   uint32_t max_weight_fixed() const;
@@ -36,7 +36,7 @@ struct TsdfSettings {
   static TsdfSettings from_config(const config::MapConfig& map, const config::SensorModel& sensor);
 };
 
-/// The local map geometry of `settings`, centred on the voxel that holds `centre_m`.
+/// The local map geometry of `settings`, centred on the brick that holds `centre_m`.
 LocalMapGeometry centred_geometry(const TsdfSettings& settings, Vec3 centre_m);
 
 }  // namespace featsense::tsdf
