@@ -52,17 +52,19 @@ __global__ void select_rays_kernel(const Vec3* endpoints, uint32_t n, LocalMapGe
 struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;
-  uint32_t* touched;
-  uint32_t* touched_count;
-  uint32_t touched_capacity;
+  uint32_t* brick_flags;
+  uint32_t* touched_bricks;
+  uint32_t* touched_brick_count;
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
     const uint32_t key = make_candidate(value, interpolated);
     // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
     if (candidates[index] <= key) return;
-    if (atomicMin(&candidates[index], key) == kEmptyCandidate) {
-      const uint32_t slot = atomicAdd(touched_count, 1u);
-      if (slot < touched_capacity) touched[slot] = static_cast<uint32_t>(index);
+    if (atomicMin(&candidates[index], key) != kEmptyCandidate) return;
+    // The first candidate of a voxel: list its brick once, for the fusion.
+    const uint32_t brick = static_cast<uint32_t>(index / kBrickVoxels);
+    if (brick_flags[brick] == 0u && atomicExch(&brick_flags[brick], 1u) == 0u) {
+      touched_bricks[atomicAdd(touched_brick_count, 1u)] = brick;
     }
   }
 };
@@ -78,30 +80,29 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
   }
 }
 
-__device__ void fuse_voxel(size_t index, uint32_t* candidates, uint32_t* map, int32_t falloff,
-                           uint32_t max_weight) {
-  const uint32_t key = candidates[index];
-  candidates[index] = kEmptyCandidate;
-  const int32_t value = candidate_value(key);
-  map[index] = pack(fuse(unpack(map[index]), value, candidate_weight(value, falloff), max_weight));
-}
-
-__global__ void fuse_touched_kernel(const uint32_t* touched, const uint32_t* touched_count,
-                                    uint32_t capacity, uint32_t* candidates, uint32_t* map,
-                                    int32_t falloff, uint32_t max_weight) {
+/// One block per touched brick, one thread per voxel: the brick's 2 KB are read and written
+/// in whole cache lines. Also resets the candidates and the brick's flag for the next scan.
+__global__ void fuse_bricks_kernel(const uint32_t* touched_bricks, const uint32_t* touched_count,
+                                   uint32_t* brick_flags, uint32_t* candidates, uint32_t* map,
+                                   int32_t falloff, uint32_t max_weight, uint32_t* voxels_updated) {
   const uint32_t count = *touched_count;
-  if (count > capacity) return;  // the list overflowed: fuse_all_kernel sweeps instead
-  for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
-    fuse_voxel(touched[k], candidates, map, falloff, max_weight);
+  for (uint32_t k = blockIdx.x; k < count; k += gridDim.x) {
+    const uint32_t brick = touched_bricks[k];
+    const size_t index = static_cast<size_t>(brick) * kBrickVoxels + threadIdx.x;
+    const uint32_t key = candidates[index];
+    const bool updated = key != kEmptyCandidate;
+    if (updated) {
+      candidates[index] = kEmptyCandidate;
+      const int32_t value = candidate_value(key);
+      map[index] =
+          pack(fuse(unpack(map[index]), value, candidate_weight(value, falloff), max_weight));
+    }
+    const int block_updated = __syncthreads_count(updated);
+    if (threadIdx.x == 0) {
+      brick_flags[brick] = 0u;
+      atomicAdd(voxels_updated, static_cast<uint32_t>(block_updated));
+    }
   }
-}
-
-/// When a scan touched more voxels than the list holds: fuse every voxel with a candidate.
-__global__ void fuse_all_kernel(size_t voxel_count, uint32_t* candidates, uint32_t* map,
-                                int32_t falloff, uint32_t max_weight) {
-  const size_t index = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (index >= voxel_count || candidates[index] == kEmptyCandidate) return;
-  fuse_voxel(index, candidates, map, falloff, max_weight);
 }
 
 class CudaIntegrator final : public Integrator {
@@ -119,11 +120,13 @@ class CudaIntegrator final : public Integrator {
     resident_blocks_ = static_cast<unsigned int>(multiprocessors) * 8u;
     map_.reserve(n);
     candidates_.reserve(n);
-    // A scan touches a small part of the map; a scan that touches more falls back to a sweep.
-    touched_capacity_ = static_cast<uint32_t>(std::min<size_t>(n, 32u << 20));
-    touched_.reserve(touched_capacity_);
-    counters_.reserve(2);
-    host_counters_.reserve(2);
+    const size_t bricks = n / kBrickVoxels;
+    brick_flags_.reserve(bricks);
+    touched_bricks_.reserve(bricks);
+    counters_.reserve(kCounters);
+    host_counters_.reserve(kCounters);
+    FEATSENSE_CUDA_CHECK(
+        cudaMemsetAsync(brick_flags_.data(), 0, bricks * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(map_.data(), 0, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(candidates_.data(), 0xFF, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -133,8 +136,8 @@ class CudaIntegrator final : public Integrator {
   std::string backend_name() const override { return "cuda"; }
   const LocalMapGeometry& geometry() const override { return geometry_; }
   size_t memory_bytes() const override {
-    return map_.bytes() + candidates_.bytes() + touched_.bytes() + kept_.bytes() +
-           endpoints_.bytes() + origins_.bytes() + counters_.bytes();
+    return map_.bytes() + candidates_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
+           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -152,9 +155,11 @@ class CudaIntegrator final : public Integrator {
     const bool origin_per_point = rays.origins_m.size() > 1;
     const size_t origin_count = origin_per_point ? n : 1;
     upload(rays, origin_count);
-    uint32_t* kept_count = counters_.data();
-    uint32_t* touched_count = counters_.data() + 1;
-    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, 2 * sizeof(uint32_t), stream_));
+    uint32_t* kept_count = counters_.data() + kKeptRays;
+    uint32_t* touched_count = counters_.data() + kTouchedBricks;
+    uint32_t* updated_count = counters_.data() + kVoxelsUpdated;
+    FEATSENSE_CUDA_CHECK(
+        cudaMemsetAsync(counters_.data(), 0, kCounters * sizeof(uint32_t), stream_));
 
     kept_.reserve(n);
     if (settings_.reduce_points_per_voxel) {
@@ -171,33 +176,28 @@ class CudaIntegrator final : public Integrator {
     params.truncation_m = settings_.truncation_m;
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
-    const ProposeCandidate propose{geometry_, candidates_.data(), touched_.data(), touched_count,
-                                   touched_capacity_};
+    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
+                                   touched_bricks_.data(), touched_count};
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(origins_.data(), origin_per_point,
                                                              endpoints_.data(), kept_.data(),
                                                              kept_count, params, propose);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
-    const int32_t falloff = settings_.falloff_start_fixed();
-    const uint32_t max_weight = settings_.max_weight_fixed();
-    fuse_touched_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
-        touched_.data(), touched_count, touched_capacity_, candidates_.data(), map_.data(), falloff,
-        max_weight);
+    fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
+        touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
+        settings_.falloff_start_fixed(), settings_.max_weight_fixed(), updated_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
-                                         2 * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream_));
+                                         kCounters * sizeof(uint32_t), cudaMemcpyDeviceToHost,
+                                         stream_));
     FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
-    stats.rays = host_counters_.data()[0];
-    stats.voxels_updated = host_counters_.data()[1];
-    if (stats.voxels_updated > touched_capacity_) {
-      fuse_all_kernel<<<blocks_for(geometry_.voxel_count()), kThreads, 0, stream_>>>(
-          geometry_.voxel_count(), candidates_.data(), map_.data(), falloff, max_weight);
-      FEATSENSE_CUDA_CHECK(cudaGetLastError());
-      FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
-    }
+    stats.rays = host_counters_.data()[kKeptRays];
+    stats.voxels_updated = host_counters_.data()[kVoxelsUpdated];
     return stats;
   }
 
  private:
+  enum Counter { kKeptRays, kTouchedBricks, kVoxelsUpdated, kCounters };
+
   void upload(const RayBatch& rays, size_t origin_count) {
     const size_t n = rays.size();
     staging_.reserve(n + origin_count);
@@ -219,8 +219,8 @@ class CudaIntegrator final : public Integrator {
   cudaStream_t stream_ = nullptr;
   cuda::DeviceBuffer<uint32_t> map_;
   cuda::DeviceBuffer<uint32_t> candidates_;
-  cuda::DeviceBuffer<uint32_t> touched_;
-  uint32_t touched_capacity_ = 0;
+  cuda::DeviceBuffer<uint32_t> brick_flags_;     ///< 1 while a brick is in touched_bricks_
+  cuda::DeviceBuffer<uint32_t> touched_bricks_;  ///< bricks with a candidate this scan
   unsigned int resident_blocks_ = 1;
   cuda::DeviceBuffer<uint32_t> kept_;
   cuda::DeviceBuffer<uint32_t> counters_;

@@ -30,16 +30,22 @@ class CpuIntegrator final : public Integrator {
       : settings_(settings),
         geometry_(centred_geometry(settings, centre_m)),
         map_(geometry_.voxel_count(), kUnobservedVoxel),
-        candidates_(new std::atomic<uint32_t>[geometry_.voxel_count()]) {
+        candidates_(new std::atomic<uint32_t>[geometry_.voxel_count()]),
+        brick_flags_(new std::atomic<uint8_t>[geometry_.voxel_count() / kBrickVoxels]) {
     for (size_t i = 0; i < geometry_.voxel_count(); ++i) {
       candidates_[i].store(kEmptyCandidate, std::memory_order_relaxed);
+    }
+    for (size_t b = 0; b < geometry_.voxel_count() / kBrickVoxels; ++b) {
+      brick_flags_[b].store(0, std::memory_order_relaxed);
     }
   }
 
   std::string backend_name() const override { return "cpu"; }
   const LocalMapGeometry& geometry() const override { return geometry_; }
   std::vector<uint32_t> download() const override { return map_; }
-  size_t memory_bytes() const override { return geometry_.voxel_count() * 2 * sizeof(uint32_t); }
+  size_t memory_bytes() const override {
+    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + geometry_.voxel_count() / kBrickVoxels;
+  }
 
   IntegrationStats integrate(const RayBatch& rays) override {
     const std::vector<uint32_t> kept = rays_to_march(rays);
@@ -54,9 +60,12 @@ class CpuIntegrator final : public Integrator {
                         std::vector<uint32_t>& touched = touched_.local();
                         const auto propose = [&](size_t index, int32_t value, bool interpolated) {
                           const uint32_t key = make_candidate(value, interpolated);
-                          // Only the ray that first fills a slot lists it: each voxel fuses once.
-                          if (atomic_min(candidates_[index], key) == kEmptyCandidate) {
-                            touched.push_back(static_cast<uint32_t>(index));
+                          if (atomic_min(candidates_[index], key) != kEmptyCandidate) return;
+                          // A voxel's first candidate: list its brick once, for the fusion.
+                          const size_t brick = index / kBrickVoxels;
+                          if (brick_flags_[brick].load(std::memory_order_relaxed) == 0 &&
+                              brick_flags_[brick].exchange(1, std::memory_order_relaxed) == 0) {
+                            touched.push_back(static_cast<uint32_t>(brick));
                           }
                         };
                         for (size_t k = range.begin(); k != range.end(); ++k) {
@@ -68,10 +77,7 @@ class CpuIntegrator final : public Integrator {
 
     IntegrationStats stats;
     stats.rays = kept.size();
-    for (const std::vector<uint32_t>& list : touched_) {
-      stats.voxels_updated += list.size();
-      fuse(list);
-    }
+    for (const std::vector<uint32_t>& bricks : touched_) stats.voxels_updated += fuse(bricks);
     return stats;
   }
 
@@ -110,28 +116,40 @@ class CpuIntegrator final : public Integrator {
     return kept;
   }
 
-  void fuse(const std::vector<uint32_t>& touched) {
+  /// Fuses the candidates of the listed bricks into the map, resets them, and returns how
+  /// many voxels were updated. Brick by brick, so memory is read in whole cache lines.
+  size_t fuse(const std::vector<uint32_t>& bricks) {
     const uint32_t max_weight = settings_.max_weight_fixed();
     const int32_t falloff = settings_.falloff_start_fixed();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 4096),
+    std::atomic<size_t> updated{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, bricks.size(), 16),
                       [&](const tbb::blocked_range<size_t>& range) {
+                        size_t local_updated = 0;
                         for (size_t k = range.begin(); k != range.end(); ++k) {
-                          const uint32_t index = touched[k];
-                          const uint32_t key = candidates_[index].exchange(
-                              kEmptyCandidate, std::memory_order_relaxed);
-                          const int32_t value = candidate_value(key);
-                          map_[index] =
-                              pack(tsdf::fuse(unpack(map_[index]), value,
-                                              candidate_weight(value, falloff), max_weight));
+                          const size_t first = static_cast<size_t>(bricks[k]) * kBrickVoxels;
+                          for (size_t index = first; index < first + kBrickVoxels; ++index) {
+                            const uint32_t key = candidates_[index].load(std::memory_order_relaxed);
+                            if (key == kEmptyCandidate) continue;
+                            candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
+                            const int32_t value = candidate_value(key);
+                            map_[index] =
+                                pack(tsdf::fuse(unpack(map_[index]), value,
+                                                candidate_weight(value, falloff), max_weight));
+                            ++local_updated;
+                          }
+                          brick_flags_[bricks[k]].store(0, std::memory_order_relaxed);
                         }
+                        updated += local_updated;
                       });
+    return updated.load();
   }
 
   TsdfSettings settings_;
   LocalMapGeometry geometry_;
   std::vector<uint32_t> map_;
   std::unique_ptr<std::atomic<uint32_t>[]> candidates_;
-  tbb::enumerable_thread_specific<std::vector<uint32_t>> touched_;
+  std::unique_ptr<std::atomic<uint8_t>[]> brick_flags_;             ///< 1 while a brick is listed
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> touched_;  ///< bricks, per thread
 };
 
 }  // namespace
