@@ -36,9 +36,13 @@ struct OusterFrameAssembler::State {
     received_columns = 0;
     std::fill(column_received.begin(), column_received.end(), uint8_t{0});
     scan = Scan::allocate(rows, cols);
-    reflectivity = &scan.add_channel("reflectivity").values;
-    nir = &scan.add_channel("nir").values;
-    signal = has_signal ? &scan.add_channel("signal").values : nullptr;
+    // All channels first: adding one may move the others.
+    scan.add_channel("reflectivity");
+    scan.add_channel("nir");
+    if (has_signal) scan.add_channel("signal");
+    reflectivity = &scan.channel("reflectivity")->values;
+    nir = &scan.channel("nir")->values;
+    signal = has_signal ? &scan.channel("signal")->values : nullptr;
   }
 
   /// Writes the valid columns of a checked packet into the frame in progress.
