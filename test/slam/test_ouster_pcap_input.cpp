@@ -133,6 +133,29 @@ TEST(OusterPcapInput, IncompleteLastFrameIsWarnedAbout) {
   EXPECT_NE(result.stats.warnings[0].find("frame 2 is incomplete"), std::string::npos);
 }
 
+TEST(OusterPcapInput, PacketsCutBySnapLengthAreSkippedAndCounted) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  std::vector<CapturedFrame> frames = test::read_pcap_frames(test::read_file(pcap));
+  // A capture with a 1000-byte snap length from the 100th record on: those lidar packets are
+  // cut, the IP length says more than the record holds.
+  size_t cut = 0;
+  for (size_t k = 100; k < frames.size(); ++k) {
+    if (frames[k].bytes.size() > 1000) {
+      frames[k].bytes.resize(1000);
+      ++cut;
+    }
+  }
+  const ReadResult result = read_pcap(write_scratch("snap", test::write_pcap(frames)), json);
+  ASSERT_EQ(result.scans.size(), 2u);  // the second frame ends cut short
+  bool counted = false;
+  for (const std::string& warning : result.stats.warnings) {
+    counted |= warning.find(std::to_string(cut) + " IP/UDP packets were damaged or cut short") !=
+               std::string::npos;
+  }
+  EXPECT_TRUE(counted);
+}
+
 TEST(OusterPcapInput, GarbageBytes) {
   FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
   FEATSENSE_SHARED_FILE(json, kOs1Json);

@@ -112,6 +112,10 @@ class OusterPcapSource final : public ScanSource {
     }
     ended_ = true;
     if (udp_.problem()) warn(*udp_.problem());
+    if (udp_.stats().malformed > 0) {
+      warn(path_ + ": " + std::to_string(udp_.stats().malformed) +
+           " IP/UDP packets were damaged or cut short by the capture's snap length; skipped");
+    }
     if (udp_.incomplete_datagrams() > 0) {
       warn(path_ + ": " + std::to_string(udp_.incomplete_datagrams()) +
            " fragmented IP datagrams could not be reassembled (fragments missing)");

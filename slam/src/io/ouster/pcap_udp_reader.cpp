@@ -129,6 +129,8 @@ std::optional<UdpDatagram> PcapUdpReader::next() {
       ++stats_.malformed;
       continue;
     }
+    // Checksums are not verified: captures taken on the sending host hold packets whose
+    // checksums the network card fills in later, so they look wrong in the file.
     const uint8_t protocol = ip[9];
     const uint16_t flags_offset = load_be<uint16_t>(ip + 6);
     const uint8_t* payload = ip + header_bytes;
