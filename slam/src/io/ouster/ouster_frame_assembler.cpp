@@ -26,6 +26,7 @@ struct OusterFrameAssembler::State {
     }
     const auto [first, last] = metadata.column_window;
     window_columns = first <= last ? last - first + 1 : cols - first + last + 1;
+    pixels.resize(static_cast<size_t>(rows));
     column_timestamp_ns.assign(static_cast<size_t>(cols), 0);
     column_received.assign(static_cast<size_t>(cols), 0);
   }
@@ -56,8 +57,9 @@ struct OusterFrameAssembler::State {
       if (!column_received[mi]) ++received_columns;
       column_received[mi] = 1;
       column_timestamp_ns[mi] = header.timestamp_ns;
+      view.column_pixels(c, pixels.data());
       for (int row = 0; row < rows; ++row) {
-        const detail::OusterPixel pixel = view.pixel(c, row);
+        const detail::OusterPixel& pixel = pixels[static_cast<size_t>(row)];
         int image_col = m + shift_by_row[static_cast<size_t>(row)];
         if (image_col >= cols) image_col -= cols;
         const size_t i = scan.index(row, image_col);
@@ -111,6 +113,7 @@ struct OusterFrameAssembler::State {
   int window_columns = 0;         ///< columns a complete frame holds
 
   detail::OusterPacketView packet;
+  std::vector<detail::OusterPixel> pixels;  ///< the column being decoded
   bool in_progress = false;
   uint16_t frame_id = 0;
   int received_columns = 0;

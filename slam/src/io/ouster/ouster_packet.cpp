@@ -90,30 +90,67 @@ OusterColumnHeader OusterPacketView::column(int column) const {
   return header;
 }
 
+namespace {
+
+/// Pixel decoders of FORMATS.md, one per profile; `p` points at the pixel's first byte.
+OusterPixel legacy_pixel(const uint8_t* p) {
+  OusterPixel out;
+  out.range_mm = load_le<uint32_t>(p) & kLegacyRangeMask;
+  out.reflectivity = load_le<uint16_t>(p + 4);
+  out.signal = load_le<uint16_t>(p + 6);
+  out.nir = load_le<uint16_t>(p + 8);
+  return out;
+}
+
+OusterPixel rng19_pixel(const uint8_t* p) {
+  OusterPixel out;
+  out.range_mm = load_le<uint32_t>(p) & kRng19Mask;
+  out.reflectivity = p[4];
+  out.signal = load_le<uint16_t>(p + 6);
+  out.nir = load_le<uint16_t>(p + 8);
+  return out;
+}
+
+OusterPixel rng15_pixel(const uint8_t* p) {
+  OusterPixel out;
+  out.range_mm = (load_le<uint16_t>(p) & kRng15Mask) * kRng15UnitMm;
+  out.reflectivity = p[2];
+  out.nir = p[3];
+  return out;
+}
+
+template <OusterPixel (*Decode)(const uint8_t*)>
+void decode_pixels(const uint8_t* first, size_t stride, int count, OusterPixel* out) {
+  for (int i = 0; i < count; ++i) out[i] = Decode(first + static_cast<size_t>(i) * stride);
+}
+
+}  // namespace
+
 OusterPixel OusterPacketView::pixel(int column, int pixel) const {
   const uint8_t* p = column_start(column) + layout_->column_header_bytes +
                      static_cast<size_t>(pixel) * layout_->pixel_bytes;
-  OusterPixel out;
   switch (layout_->profile) {
     case OusterProfile::kLegacy:
-      out.range_mm = load_le<uint32_t>(p) & kLegacyRangeMask;
-      out.reflectivity = load_le<uint16_t>(p + 4);
-      out.signal = load_le<uint16_t>(p + 6);
-      out.nir = load_le<uint16_t>(p + 8);
-      break;
+      return legacy_pixel(p);
     case OusterProfile::kRng19Rfl8Sig16Nir16:
-      out.range_mm = load_le<uint32_t>(p) & kRng19Mask;
-      out.reflectivity = p[4];
-      out.signal = load_le<uint16_t>(p + 6);
-      out.nir = load_le<uint16_t>(p + 8);
-      break;
+      return rng19_pixel(p);
     case OusterProfile::kRng15Rfl8Nir8:
-      out.range_mm = (load_le<uint16_t>(p) & kRng15Mask) * kRng15UnitMm;
-      out.reflectivity = p[2];
-      out.nir = p[3];
-      break;
+      return rng15_pixel(p);
   }
-  return out;
+  return {};
+}
+
+void OusterPacketView::column_pixels(int column, OusterPixel* out) const {
+  const uint8_t* first = column_start(column) + layout_->column_header_bytes;
+  const size_t stride = layout_->pixel_bytes;
+  switch (layout_->profile) {
+    case OusterProfile::kLegacy:
+      return decode_pixels<legacy_pixel>(first, stride, layout_->pixels, out);
+    case OusterProfile::kRng19Rfl8Sig16Nir16:
+      return decode_pixels<rng19_pixel>(first, stride, layout_->pixels, out);
+    case OusterProfile::kRng15Rfl8Nir8:
+      return decode_pixels<rng15_pixel>(first, stride, layout_->pixels, out);
+  }
 }
 
 }  // namespace featsense::slam::detail

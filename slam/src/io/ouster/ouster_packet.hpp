@@ -51,6 +51,8 @@ class OusterPacketView {
   uint16_t frame_id() const;
   OusterColumnHeader column(int column) const;
   OusterPixel pixel(int column, int pixel) const;
+  /// All layout.pixels pixels of a column into `out` (one profile dispatch per column).
+  void column_pixels(int column, OusterPixel* out) const;
 
  private:
   const uint8_t* column_start(int column) const {
