@@ -91,10 +91,12 @@ inline std::vector<uint8_t> compress(TestCompression c, const std::vector<uint8_
   if (c == TestCompression::kBz2) {
     unsigned int size = static_cast<unsigned int>(in.size() + in.size() / 100 + 600);
     out.resize(size);
-    std::vector<uint8_t> source = in;  // libbz2 takes non-const input
+    // libbz2 takes non-const input and rejects a null pointer (an empty vector's data()).
+    std::vector<uint8_t> source = in;
+    source.push_back(0);
     const int rc = BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(out.data()), &size,
                                             reinterpret_cast<char*>(source.data()),
-                                            static_cast<unsigned int>(source.size()), 9, 0, 0);
+                                            static_cast<unsigned int>(in.size()), 9, 0, 0);
     if (rc != BZ_OK) throw std::runtime_error("bz2 compression failed");
     out.resize(size);
   } else {

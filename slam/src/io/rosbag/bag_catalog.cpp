@@ -13,10 +13,12 @@ struct Walk {
   std::vector<std::string> warnings;
 };
 
-Walk walk(std::istream& stream, const std::string& origin, bool read_chunks) {
+Walk walk(std::istream& stream, const std::string& origin, bool read_chunks,
+          uint64_t max_chunk_bytes) {
   Walk result;
   BagReadOptions options;
   options.read_chunks = read_chunks;
+  options.max_chunk_bytes = max_chunk_bytes;
   options.wanted = [](const BagMessage&, const BagConnection*) { return false; };
   options.warn = [&result](const std::string& message) { result.warnings.push_back(message); };
   BagRecordReader reader(stream, origin, options);
@@ -46,9 +48,9 @@ const BagTopic* BagCatalog::find(std::string_view topic) const {
   return nullptr;
 }
 
-BagCatalog catalog_bag(std::istream& stream, const std::string& origin) {
+BagCatalog catalog_bag(std::istream& stream, const std::string& origin, uint64_t max_chunk_bytes) {
   BagCatalog catalog;
-  Walk pass = walk(stream, origin, /*read_chunks=*/false);
+  Walk pass = walk(stream, origin, /*read_chunks=*/false, max_chunk_bytes);
   std::map<uint32_t, uint64_t> counts;
   if (cheap_walk_suffices(pass)) {
     catalog.from_index = true;
@@ -56,7 +58,7 @@ BagCatalog catalog_bag(std::istream& stream, const std::string& origin) {
     // Messages outside chunks are not indexed by chunk; the walk counted them itself.
     for (const auto& [id, count] : pass.stats.message_counts) counts[id] += count;
   } else {
-    pass = walk(stream, origin, /*read_chunks=*/true);
+    pass = walk(stream, origin, /*read_chunks=*/true, max_chunk_bytes);
     counts = pass.stats.message_counts;
   }
   catalog.connections = pass.connections;

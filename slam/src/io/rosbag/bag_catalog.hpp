@@ -40,8 +40,10 @@ struct BagCatalog {
 /// Catalogs a bag: first a walk over the top-level records only (chunk data skipped with
 /// seekg); where that walk is incomplete (no index written, damage, connections missing),
 /// a full walk that decompresses one chunk at a time and counts the messages. Throws
-/// InputError where the stream is not a bag of format 2.0.
-BagCatalog catalog_bag(std::istream& stream, const std::string& origin);
+/// InputError where the stream is not a bag of format 2.0. `max_chunk_bytes` as in
+/// BagReadOptions.
+BagCatalog catalog_bag(std::istream& stream, const std::string& origin,
+                       uint64_t max_chunk_bytes = BagReadOptions().max_chunk_bytes);
 
 /// The `data` of the first std_msgs/String message on `topic` (e.g. Ouster's metadata
 /// JSON), or nullopt where the topic has no readable message.

@@ -124,13 +124,15 @@ ChunkDecompression run_decoder(Decoder& decoder, ByteView input, size_t declared
   size_t produced = 0;
   size_t in_pos = 0;
   for (;;) {
+    // The reused buffer may be longer than this chunk: the declared size bounds the writes,
+    // not the buffer's size, so produced <= declared always holds.
     const bool probing = produced == declared;
     if (!probing && produced == output.size()) {
       const size_t wanted = std::max({output.size() * 2, produced + kMinGrowth, 4 * input.size});
       output.resize(std::min(declared, wanted));
     }
     uint8_t* out = probing ? probe : output.data() + produced;
-    const size_t out_size = probing ? sizeof(probe) : output.size() - produced;
+    const size_t out_size = probing ? sizeof(probe) : std::min(output.size(), declared) - produced;
     const Step step = decoder.step(input.data + in_pos, input.size - in_pos, out, out_size);
     if (!step.error.empty()) {
       return result(Status::kCorrupt, produced, step.error + " after " + sizes(produced, declared));
