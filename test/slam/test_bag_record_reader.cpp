@@ -256,6 +256,60 @@ TEST(BagRecordReader, HoldsAboutOneChunkInMemory) {
   EXPECT_LT(read.max_buffer_bytes, written.bytes.size() / 4);
 }
 
+/// What rosbag leaves when recording stops without closing the bag: the open chunk's header
+/// still holds the place-holder sizes 0 and 0, and its records follow it.
+std::vector<uint8_t> with_open_chunk(const WrittenBag& unclosed, TestCompression compression,
+                                     const std::vector<std::vector<uint8_t>>& payloads) {
+  test::RosBytes records;
+  for (const std::vector<uint8_t>& payload : payloads) {
+    test::RosBytes header;
+    header.field("op", std::vector<uint8_t>{0x02})
+        .field("conn", test::le_bytes(uint32_t{0}))
+        .field("time", test::time_bytes(1800000000000000000));
+    records.raw(test::bag_record(header, payload));
+  }
+  test::RosBytes chunk_header;
+  chunk_header.field("op", std::vector<uint8_t>{0x05})
+      .field("compression", std::string(test::compression_name(compression)))
+      .field("size", test::le_bytes(uint32_t{0}));
+  std::vector<uint8_t> bag = unclosed.bytes;
+  const std::vector<uint8_t> open_chunk = test::bag_record(chunk_header, {});
+  bag.insert(bag.end(), open_chunk.begin(), open_chunk.end());
+  const std::vector<uint8_t> data = test::compress(compression, records.bytes());
+  bag.insert(bag.end(), data.begin(), data.end());
+  return bag;
+}
+
+TEST(BagRecordReader, UnclosedBagWithAnOpenChunk) {
+  const std::vector<std::vector<uint8_t>> last = {std::vector<uint8_t>(500, 1),
+                                                  std::vector<uint8_t>(700, 2)};
+  // Uncompressed: the open chunk's records follow its header as they were written, and
+  // are read as records outside a chunk.
+  const WrittenBag unclosed = write_bag(TestCompression::kNone, false);
+  const ReadBack read =
+      read_all(as_string(with_open_chunk(unclosed, TestCompression::kNone, last)));
+  EXPECT_TRUE(read.warnings.empty()) << read.warnings[0];
+  ASSERT_EQ(read.messages.size(), unclosed.payloads.size() + 2);
+  ReadBack closed_part = read;
+  closed_part.messages.resize(unclosed.payloads.size());
+  closed_part.payloads.resize(unclosed.payloads.size());
+  expect_prefix_of(closed_part, unclosed);
+  EXPECT_EQ(read.payloads[unclosed.payloads.size()], last[0]);
+  EXPECT_EQ(read.payloads[unclosed.payloads.size() + 1], last[1]);
+
+  // Compressed: the open chunk cannot be told apart from junk; the closed chunks are read and
+  // a warning says where reading stopped.
+  for (const TestCompression compression : {TestCompression::kBz2, TestCompression::kLz4}) {
+    SCOPED_TRACE(test::compression_name(compression));
+    const WrittenBag compressed = write_bag(compression, false);
+    const ReadBack partial = read_all(as_string(with_open_chunk(compressed, compression, last)));
+    EXPECT_EQ(partial.messages.size(), compressed.payloads.size());
+    expect_prefix_of(partial, compressed);
+    ASSERT_EQ(partial.warnings.size(), 1u);
+    EXPECT_NE(partial.warnings[0].find("the rest is unreadable"), std::string::npos);
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // Damaged input
 
@@ -286,7 +340,7 @@ TEST(BagRecordReader, TruncatedAnywhereGivesAPrefixAndAWarning) {
     const WrittenBag written = write_bag(compression, true, 30, 3000);
     const size_t size = written.bytes.size();
     size_t cut_with_fewer = 0;
-    for (size_t cut = 13; cut < size; cut += (cut < 4200 ? 509 : 41)) {
+    for (size_t cut = 13; cut < size; cut += (cut < 4200 ? 509 : 97)) {
       SCOPED_TRACE("cut at " + std::to_string(cut));
       const std::string bag = as_string(written.bytes).substr(0, cut);
       const ReadBack read = read_all(bag);

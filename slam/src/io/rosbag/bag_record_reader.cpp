@@ -174,7 +174,9 @@ void BagRecordReader::read_chunk(const BagRecordHeader& header, uint64_t record_
       skip_to(chunk_end);
     }
   };
-  if (!options_.read_chunks) return finish_record();
+  // Sizes 0 and 0 are also what rosbag writes before a chunk is closed: nothing to read here
+  // (an unclosed uncompressed chunk's records follow as if outside a chunk).
+  if (!options_.read_chunks || (declared_size == 0 && data_size == 0)) return finish_record();
 
   const std::optional<ChunkCompression> compression = parse_chunk_compression(name);
   if (!compression) {
