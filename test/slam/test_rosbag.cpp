@@ -1,0 +1,412 @@
+// The ROS bag source with PointCloud2 topics: bags written by the test writer read back
+// through the source, topic choice and its errors, damaged bags, and reading speed.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "io/rosbag/rosbag_source.hpp"
+#include "slam/rosbag_test_clouds.hpp"
+#include "slam/rosbag_test_source.hpp"
+#include "slam/rosbag_test_writer.hpp"
+
+namespace featsense::slam {
+namespace {
+
+using test::CloudSpec;
+using test::TestBagWriter;
+using test::TestCompression;
+
+constexpr int64_t kFirstStamp = 1700000000123456789;
+constexpr int64_t kFramePeriodNs = 100000000;
+
+CloudSpec frame_spec(CloudSpec spec, int frame) {
+  spec.stamp_ns = kFirstStamp + frame * kFramePeriodNs;
+  return spec;
+}
+
+/// A bag of `frames` reference clouds on /points, with some other traffic beside them.
+std::vector<uint8_t> cloud_bag(TestCompression compression, const CloudSpec& spec, int frames,
+                               bool with_index = true, size_t chunk_bytes = 30000) {
+  TestBagWriter writer(compression, chunk_bytes);
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  const uint32_t note = writer.add_connection("/note", "std_msgs/String");
+  for (int frame = 0; frame < frames; ++frame) {
+    const CloudSpec s = frame_spec(spec, frame);
+    writer.add_message(points, s.stamp_ns + 5000000, test::make_reference_cloud(s).serialize());
+    writer.add_message(note, s.stamp_ns + 6000000, test::serialize_string_message("frame"));
+  }
+  return writer.finish(with_index);
+}
+
+std::unique_ptr<ScanSource> open_bag(const std::string& path, const SourceOptions& options = {}) {
+  static test::StandInLog log;
+  return open_rosbag_source(path, options, test::stand_in_dependencies(log));
+}
+
+std::string error_of(const std::string& path, const SourceOptions& options = {}) {
+  try {
+    open_bag(path, options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST(Rosbag, ReadsOrganizedCloudsOfEveryCompression) {
+  const auto dir = test::scratch_dir("rosbag_every_compression");
+  for (const TestCompression compression :
+       {TestCompression::kNone, TestCompression::kBz2, TestCompression::kLz4}) {
+    for (const uint8_t xyz_type : {test::kFloat32, test::kFloat64}) {
+      for (const bool with_index : {true, false}) {
+        const std::string name = std::string(test::compression_name(compression)) + "_" +
+                                 std::to_string(xyz_type) + (with_index ? "" : "_unindexed");
+        SCOPED_TRACE(name);
+        CloudSpec spec;
+        spec.xyz_type = xyz_type;
+        spec.intensity_type = test::kUint16;
+        spec.ring_type = test::kUint16;
+        const int frames = 5;
+        const std::string path = test::write_bag_file(
+            dir, name + ".bag", cloud_bag(compression, spec, frames, with_index));
+        const std::unique_ptr<ScanSource> source = open_bag(path);
+        const SourceInfo& info = source->info();
+        EXPECT_EQ(info.format, "rosbag");
+        EXPECT_EQ(info.path, path);
+        EXPECT_EQ(info.frames, static_cast<size_t>(frames));
+        EXPECT_EQ(info.fields, (std::vector<std::string>{"x", "y", "z", "intensity", "ring", "t"}));
+        // 16 rows: the 16-beam preset, with the cloud's columns.
+        EXPECT_EQ(info.sensor.name, "vlp16");
+        EXPECT_EQ(info.sensor.columns, test::kRefCols);
+        EXPECT_FALSE(info.sensor_from_metadata);
+        EXPECT_TRUE(contains(info.detail, "topic /points (sensor_msgs/PointCloud2)"))
+            << info.detail;
+        EXPECT_TRUE(contains(info.detail, test::compression_name(compression))) << info.detail;
+        EXPECT_EQ(contains(info.detail, "no usable index"), !with_index) << info.detail;
+
+        const std::vector<Scan> scans = test::read_scans(*source);
+        ASSERT_EQ(scans.size(), static_cast<size_t>(frames));
+        for (int frame = 0; frame < frames; ++frame) {
+          SCOPED_TRACE("frame " + std::to_string(frame));
+          test::expect_reference_scan(scans[static_cast<size_t>(frame)], frame_spec(spec, frame),
+                                      1e-9);
+          EXPECT_EQ(scans[static_cast<size_t>(frame)].sequence, static_cast<uint64_t>(frame));
+        }
+        EXPECT_EQ(source->stats().frames_read, static_cast<size_t>(frames));
+        EXPECT_EQ(source->stats().warning_count, 0u);
+        EXPECT_FALSE(source->next().has_value());  // stays at the end
+      }
+    }
+  }
+}
+
+TEST(Rosbag, VelodyneStyleCloudsComeOutHighestRowFirst) {
+  const auto dir = test::scratch_dir("rosbag_velodyne_style");
+  CloudSpec spec;
+  spec.lowest_first = true;
+  spec.time_field = "time";
+  spec.intensity_type = test::kUint8;
+  const std::string path =
+      test::write_bag_file(dir, "v.bag", cloud_bag(TestCompression::kLz4, spec, 3));
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 3u);
+  CloudSpec expected = spec;
+  expected.lowest_first = false;
+  for (int frame = 0; frame < 3; ++frame) {
+    test::expect_reference_scan(scans[static_cast<size_t>(frame)], frame_spec(expected, frame),
+                                1e-6);
+  }
+}
+
+TEST(Rosbag, UnusualRowCountGetsAnEstimatedSensor) {
+  const auto dir = test::scratch_dir("rosbag_estimated_sensor");
+  CloudSpec spec;
+  spec.rows = 40;
+  const std::string path =
+      test::write_bag_file(dir, "40.bag", cloud_bag(TestCompression::kNone, spec, 2));
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  EXPECT_EQ(source->info().sensor.beams, 40);
+  EXPECT_EQ(source->info().sensor.columns, test::kRefCols);
+  EXPECT_TRUE(contains(source->info().sensor.name, "estimated")) << source->info().sensor.name;
+  EXPECT_NEAR(source->info().sensor.vertical_fov_rad(), 30.0 * M_PI / 180.0, 1e-6);
+  EXPECT_EQ(test::read_scans(*source).size(), 2u);
+
+  // An explicit preset wins.
+  SourceOptions options;
+  options.sensor_preset = "os1-64";
+  EXPECT_EQ(open_bag(path, options)->info().sensor.name, "os1-64");
+}
+
+TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {
+  const auto dir = test::scratch_dir("rosbag_unorganized");
+  // The reference scene flattened into one row, rings numbered from the lowest beam up.
+  CloudSpec spec;
+  spec.lowest_first = true;
+  test::TestCloud cloud = test::make_reference_cloud(spec);
+  cloud.width *= cloud.height;
+  cloud.height = 1;
+  cloud.row_step = cloud.width * cloud.point_step;
+  TestBagWriter writer(TestCompression::kBz2);
+  const uint32_t points = writer.add_connection("/velodyne_points", "sensor_msgs/PointCloud2");
+  writer.add_message(points, kFirstStamp, cloud.serialize());
+  writer.add_message(points, kFirstStamp + kFramePeriodNs, cloud.serialize());
+  const std::string path = test::write_bag_file(dir, "u.bag", writer.finish());
+
+  test::StandInLog log;
+  const std::unique_ptr<ScanSource> source =
+      open_rosbag_source(path, {}, test::stand_in_dependencies(log));
+  EXPECT_EQ(source->info().sensor.name, "vlp16");  // by its 16 rings
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[1].sequence, 1u);
+  ASSERT_EQ(log.organized_clouds.size(), 2u);
+  const PointCloud& handed = log.organized_clouds[0];
+  EXPECT_EQ(log.organized_for[0].name, "vlp16");
+  ASSERT_EQ(handed.size(), cloud.width);
+  EXPECT_TRUE(handed.ring_counts_up);
+  EXPECT_EQ(handed.stamp_ns, spec.stamp_ns);
+  for (int stored_row = 0; stored_row < test::kRefRows; ++stored_row) {
+    for (int col = 0; col < test::kRefCols; ++col) {
+      const size_t i = static_cast<size_t>(stored_row * test::kRefCols + col);
+      const test::ReferencePoint p = test::reference_point(test::kRefRows - 1 - stored_row, col);
+      EXPECT_EQ(handed.ring[i], stored_row);
+      if (p.valid) {
+        EXPECT_EQ(handed.xyz[i], p.xyz.cast<float>());
+      }
+    }
+  }
+
+  // Without a ring field nothing tells the beams: the user must name the sensor.
+  test::TestCloud no_ring = cloud;
+  no_ring.fields[4].name = "unused";
+  TestBagWriter no_ring_writer(TestCompression::kNone);
+  const uint32_t c = no_ring_writer.add_connection("/cloud", "sensor_msgs/PointCloud2");
+  no_ring_writer.add_message(c, kFirstStamp, no_ring.serialize());
+  const std::string no_ring_path = test::write_bag_file(dir, "n.bag", no_ring_writer.finish());
+  EXPECT_TRUE(contains(error_of(no_ring_path), "set sensor.preset")) << error_of(no_ring_path);
+  SourceOptions options;
+  options.sensor_preset = "hdl32";
+  EXPECT_EQ(open_bag(no_ring_path, options)->info().sensor.name, "hdl32");
+}
+
+// ---------------------------------------------------------------------------------------
+// Topic choice
+
+TEST(Rosbag, TopicChoice) {
+  const auto dir = test::scratch_dir("rosbag_topic_choice");
+  TestBagWriter writer(TestCompression::kLz4);
+  const uint32_t front = writer.add_connection("/front/points", "sensor_msgs/PointCloud2");
+  const uint32_t rear = writer.add_connection("/rear/points", "sensor_msgs/PointCloud2");
+  const uint32_t imu = writer.add_connection("/imu", "sensor_msgs/Imu");
+  CloudSpec front_spec;
+  CloudSpec rear_spec;
+  rear_spec.stamp_ns = kFirstStamp + 777;
+  writer.add_message(front, kFirstStamp, test::make_reference_cloud(front_spec).serialize());
+  writer.add_message(rear, kFirstStamp, test::make_reference_cloud(rear_spec).serialize());
+  writer.add_message(imu, kFirstStamp, std::vector<uint8_t>(300, 1));
+  const std::string path = test::write_bag_file(dir, "two.bag", writer.finish());
+
+  // Two cloud topics and no choice: the error lists both and says how to choose.
+  const std::string both = error_of(path);
+  EXPECT_TRUE(contains(both, "/front/points")) << both;
+  EXPECT_TRUE(contains(both, "/rear/points")) << both;
+  EXPECT_TRUE(contains(both, "--topic")) << both;
+  EXPECT_FALSE(contains(both, "/imu")) << both;
+
+  SourceOptions options;
+  options.topic = "/rear/points";
+  const std::unique_ptr<ScanSource> source = open_bag(path, options);
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  test::expect_reference_scan(scans[0], rear_spec, 1e-9);
+
+  options.topic = "/rear/point";
+  const std::string unknown = error_of(path, options);
+  EXPECT_TRUE(contains(unknown, "no topic '/rear/point'")) << unknown;
+  EXPECT_TRUE(contains(unknown, "did you mean '/rear/points'")) << unknown;
+
+  options.topic = "/imu";
+  const std::string wrong_type = error_of(path, options);
+  EXPECT_TRUE(contains(wrong_type, "sensor_msgs/Imu, which is not a scan type")) << wrong_type;
+
+  // A bag without any scan topic.
+  TestBagWriter no_scans(TestCompression::kNone);
+  const uint32_t only = no_scans.add_connection("/imu", "sensor_msgs/Imu");
+  no_scans.add_message(only, kFirstStamp, std::vector<uint8_t>(10, 0));
+  const std::string none = error_of(test::write_bag_file(dir, "none.bag", no_scans.finish()));
+  EXPECT_TRUE(contains(none, "no topic holds scans")) << none;
+}
+
+TEST(Rosbag, RealOusterBagChoosesTheLidarPackets) {
+  FEATSENSE_SHARED_FILE(path, "ouster/512x10_raw.bag");
+  test::StandInLog log;
+  EXPECT_THROW(open_rosbag_source(path.string(), {}, test::stand_in_dependencies(log)), InputError);
+  EXPECT_EQ(log.packet_topic, "/os_node0/lidar_packets");
+
+  SourceOptions options;
+  options.topic = "/os_node0/imu_packets";
+  const std::string imu = error_of(path.string(), options);
+  EXPECT_TRUE(contains(imu, "IMU packets")) << imu;
+}
+
+// ---------------------------------------------------------------------------------------
+// Damaged input
+
+TEST(Rosbag, BadMessagesAreSkippedWithCountedWarnings) {
+  const auto dir = test::scratch_dir("rosbag_bad_messages");
+  TestBagWriter writer(TestCompression::kLz4);
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  const test::TestCloud good = test::make_reference_cloud({});
+  test::TestCloud big_endian = good;
+  big_endian.is_bigendian = 1;
+  test::TestCloud past_step = good;
+  past_step.fields[5].offset = past_step.point_step;  // t starts where the point ends
+  std::vector<uint8_t> cut = good.serialize();
+  cut.resize(cut.size() / 2);
+  writer.add_message(points, kFirstStamp, good.serialize());
+  writer.add_message(points, kFirstStamp, big_endian.serialize());
+  writer.add_message(points, kFirstStamp, past_step.serialize());
+  writer.add_message(points, kFirstStamp, cut);
+  writer.add_message(points, kFirstStamp, good.serialize());
+  const std::string path = test::write_bag_file(dir, "bad.bag", writer.finish());
+
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].sequence, 0u);
+  EXPECT_EQ(scans[1].sequence, 4u);
+  const ReadStats& stats = source->stats();
+  EXPECT_EQ(stats.frames_read, 2u);
+  EXPECT_EQ(stats.frames_skipped, 3u);
+  ASSERT_EQ(stats.warning_count, 3u);
+  EXPECT_TRUE(contains(stats.warnings[0], "big-endian")) << stats.warnings[0];
+  EXPECT_TRUE(contains(stats.warnings[1], "past point_step")) << stats.warnings[1];
+  EXPECT_TRUE(contains(stats.warnings[2], "remain")) << stats.warnings[2];
+
+  // When no message of the topic is readable, opening fails and says why.
+  TestBagWriter all_bad(TestCompression::kNone);
+  const uint32_t c = all_bad.add_connection("/points", "sensor_msgs/PointCloud2");
+  all_bad.add_message(c, kFirstStamp, big_endian.serialize());
+  const std::string error = error_of(test::write_bag_file(dir, "all_bad.bag", all_bad.finish()));
+  EXPECT_TRUE(contains(error, "no readable PointCloud2 message on /points")) << error;
+  EXPECT_TRUE(contains(error, "big-endian")) << error;
+}
+
+TEST(Rosbag, NotABag) {
+  const auto dir = test::scratch_dir("rosbag_not_a_bag");
+  EXPECT_TRUE(contains(error_of(test::write_bag_file(dir, "empty.bag", {})), "empty file"));
+  const std::string text = "hello\n";
+  EXPECT_TRUE(contains(error_of(test::write_bag_file(
+                           dir, "text.bag", std::vector<uint8_t>(text.begin(), text.end()))),
+                       "not a ROS bag"));
+  EXPECT_TRUE(contains(error_of((dir / "missing.bag").string()), "cannot open"));
+}
+
+TEST(Rosbag, TruncatedBagsGiveFewerFramesOrAnError) {
+  const auto dir = test::scratch_dir("rosbag_truncated");
+  for (const TestCompression compression : {TestCompression::kNone, TestCompression::kLz4}) {
+    SCOPED_TRACE(test::compression_name(compression));
+    const int frames = 6;
+    const std::vector<uint8_t> whole = cloud_bag(compression, CloudSpec{}, frames, true, 30000);
+    size_t errors = 0;
+    size_t partial = 0;
+    for (size_t cut = 0; cut < whole.size(); cut += 1 + whole.size() / 97) {
+      SCOPED_TRACE("cut at " + std::to_string(cut));
+      const std::string path = test::write_bag_file(
+          dir, "cut.bag", std::vector<uint8_t>(whole.begin(), whole.begin() + cut));
+      std::unique_ptr<ScanSource> source;
+      try {
+        source = open_bag(path);
+      } catch (const InputError&) {
+        ++errors;
+        continue;
+      }
+      const std::vector<Scan> scans = test::read_scans(*source);
+      ASSERT_LE(scans.size(), static_cast<size_t>(frames));
+      for (size_t i = 0; i < scans.size(); ++i) {
+        test::expect_reference_scan(scans[i], frame_spec(CloudSpec{}, static_cast<int>(i)), 1e-9);
+      }
+      EXPECT_GT(source->stats().warning_count, 0u);  // a cut bag always says so
+      if (scans.size() < static_cast<size_t>(frames)) ++partial;
+    }
+    EXPECT_GT(errors, 0u);
+    EXPECT_GT(partial, 50u);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Speed
+
+TEST(Rosbag, ReadingSpeedOfLargeOrganizedClouds) {
+  // 50 clouds of 128 x 1024 points in the Ouster driver's layout: 48-byte points holding
+  // x y z intensity t reflectivity ring ambient range (6.3 MB a message), lz4 chunks.
+  const auto dir = test::scratch_dir("rosbag_speed");
+  CloudSpec spec;
+  spec.rows = 128;
+  spec.cols = 1024;
+  test::TestCloud cloud = test::make_reference_cloud(spec);
+  test::TestCloud ouster;
+  for (const char* axis : {"x", "y", "z"}) ouster.add_field(axis, test::kFloat32);
+  ouster.point_step += 4;
+  ouster.add_field("intensity", test::kFloat32);
+  ouster.add_field("t", test::kUint32);
+  ouster.add_field("reflectivity", test::kUint16);
+  ouster.add_field("ring", test::kUint16);
+  ouster.add_field("ambient", test::kUint16);
+  ouster.point_step += 2;
+  ouster.add_field("range", test::kUint32);
+  ouster.point_step = 48;
+  ouster.allocate(128, 1024);
+  ouster.stamp_ns = kFirstStamp;
+  for (size_t i = 0; i < static_cast<size_t>(128 * 1024); ++i) {
+    const uint8_t* from = cloud.data.data() + i * cloud.point_step;
+    uint8_t* to = ouster.data.data() + i * ouster.point_step;
+    std::memcpy(to, from, 12);           // x y z
+    std::memcpy(to + 16, from + 12, 4);  // intensity
+    std::memcpy(to + 20, from + 18, 4);  // t
+    std::memcpy(to + 26, from + 16, 2);  // ring
+  }
+  const int messages = 50;
+  TestBagWriter writer(TestCompression::kLz4);
+  const uint32_t points = writer.add_connection("/os_cloud_node/points", "sensor_msgs/PointCloud2");
+  size_t message_bytes = 0;
+  for (int m = 0; m < messages; ++m) {
+    ouster.stamp_ns = kFirstStamp + m * kFramePeriodNs;
+    const std::vector<uint8_t> message = ouster.serialize();
+    message_bytes += message.size();
+    writer.add_message(points, ouster.stamp_ns, message);
+  }
+  const std::vector<uint8_t> bag = writer.finish();
+  const std::string path = test::write_bag_file(dir, "speed.bag", bag);
+
+  const auto start = std::chrono::steady_clock::now();
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  size_t valid = 0;
+  size_t scans = 0;
+  while (std::optional<Scan> scan = source->next()) {
+    valid += scan->valid_count();
+    ++scans;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(scans, static_cast<size_t>(messages));
+  EXPECT_EQ(valid, static_cast<size_t>(messages) * (128 * 1024 - 2));
+  std::printf(
+      "[ speed    ] %d messages of 128 x 1024 points, %.1f MB of messages in %.1f MB of "
+      "lz4 bag: %.2f s, %.1f messages/s, %.0f MB/s of messages, %.0f MB/s of file\n",
+      messages, static_cast<double>(message_bytes) / 1e6, static_cast<double>(bag.size()) / 1e6,
+      seconds, messages / seconds, static_cast<double>(message_bytes) / 1e6 / seconds,
+      static_cast<double>(bag.size()) / 1e6 / seconds);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace featsense::slam
