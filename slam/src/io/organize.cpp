@@ -1,0 +1,133 @@
+// organize(): unorganized points into the rows x cols range image of scan.hpp.
+
+#include "featsense/slam/io/organize.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace featsense::slam {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+bool is_data(const Eigen::Vector3f& p) {
+  return p.allFinite() && !(p.x() == 0.0f && p.y() == 0.0f && p.z() == 0.0f);
+}
+
+/// Half the gap to the neighbouring beam beyond which a point at the edge of the fan is
+/// taken as outside it; a single-beam sensor gets half a degree.
+double half_spacing_at(const std::vector<double>& elevation_rad, size_t beam) {
+  if (elevation_rad.size() < 2) return 0.5 * M_PI / 180.0;
+  const size_t other = beam == 0 ? 1 : beam - 1;
+  return 0.5 * std::abs(elevation_rad[beam] - elevation_rad[other]);
+}
+
+/// The beam (row) whose elevation is nearest to `elevation_rad`, or -1 when the point lies
+/// more than half a beam spacing above the highest or below the lowest beam.
+/// `beams_rad` is sorted from the highest to the lowest beam (SensorModel's order).
+int nearest_beam(const std::vector<double>& beams_rad, double elevation_rad) {
+  if (beams_rad.empty()) return -1;
+  const size_t last = beams_rad.size() - 1;
+  if (elevation_rad > beams_rad.front() + half_spacing_at(beams_rad, 0)) return -1;
+  if (elevation_rad < beams_rad.back() - half_spacing_at(beams_rad, last)) return -1;
+  // First beam at or below the point (the list is descending).
+  const auto below =
+      std::lower_bound(beams_rad.begin(), beams_rad.end(), elevation_rad, std::greater<double>());
+  if (below == beams_rad.begin()) return 0;
+  if (below == beams_rad.end()) return static_cast<int>(last);
+  const auto above = below - 1;
+  const bool above_nearer = (*above - elevation_rad) <= (elevation_rad - *below);
+  return static_cast<int>((above_nearer ? above : below) - beams_rad.begin());
+}
+
+void check_sizes(const PointCloud& cloud) {
+  const size_t n = cloud.size();
+  auto check = [n](size_t size, const std::string& what) {
+    if (size != 0 && size != n) {
+      throw std::invalid_argument("organize: " + what + " has " + std::to_string(size) +
+                                  " values for " + std::to_string(n) + " points");
+    }
+  };
+  check(cloud.ring.size(), "ring");
+  check(cloud.time_offset_s.size(), "time_offset_s");
+  check(cloud.range_m.size(), "range_m");
+  for (const ScanChannel& c : cloud.channels) check(c.values.size(), "channel " + c.name);
+}
+
+}  // namespace
+
+int column_of(const Eigen::Vector3f& xyz, int columns) {
+  if (columns <= 0) return 0;
+  // Clockwise from +x seen from above (+z): the negated mathematical azimuth. Column c is
+  // centred on c * 2 pi / columns, as Ouster's measurement ids are.
+  double clockwise = -std::atan2(static_cast<double>(xyz.y()), static_cast<double>(xyz.x()));
+  if (!std::isfinite(clockwise)) return 0;
+  if (clockwise < 0.0) clockwise += kTwoPi;
+  const long column = std::lround(clockwise / kTwoPi * columns);
+  return static_cast<int>(column % columns);
+}
+
+Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, OrganizeStats* stats) {
+  check_sizes(cloud);
+  if (sensor.beams < 1 || sensor.columns < 1) {
+    throw std::invalid_argument("organize: sensor '" + sensor.name + "' has no beams or columns");
+  }
+  const bool by_ring = !cloud.ring.empty();
+  if (!by_ring && static_cast<int>(sensor.elevation_rad.size()) != sensor.beams) {
+    throw std::invalid_argument("organize: sensor '" + sensor.name + "' lacks beam elevations");
+  }
+  OrganizeStats counts;
+  counts.input_points = cloud.size();
+
+  Scan scan = Scan::allocate(sensor.beams, sensor.columns);
+  std::vector<ScanChannel*> channels;
+  for (const ScanChannel& c : cloud.channels) scan.add_channel(c.name);
+  // Pointers only after every add_channel: adding moves the vector's elements.
+  for (const ScanChannel& c : cloud.channels) channels.push_back(scan.channel(c.name));
+
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.xyz[i];
+    if (!is_data(p)) {
+      ++counts.dropped_invalid;
+      continue;
+    }
+    int row = -1;
+    if (by_ring) {
+      const int ring = cloud.ring[i];
+      if (ring >= 0 && ring < sensor.beams) {
+        row = cloud.ring_counts_up ? sensor.beams - 1 - ring : ring;
+      }
+    } else {
+      const double horizontal = std::hypot(static_cast<double>(p.x()), static_cast<double>(p.y()));
+      row = nearest_beam(sensor.elevation_rad, std::atan2(static_cast<double>(p.z()), horizontal));
+    }
+    if (row < 0) {
+      ++counts.dropped_outside;
+      continue;
+    }
+    const size_t cell = scan.index(row, column_of(p, sensor.columns));
+    const float range =
+        !cloud.range_m.empty() && std::isfinite(cloud.range_m[i]) && cloud.range_m[i] > 0.0f
+            ? cloud.range_m[i]
+            : p.norm();
+    if (scan.valid[cell]) {
+      ++counts.dropped_collisions;
+      if (scan.range_m[cell] <= range) continue;
+    }
+    scan.valid[cell] = 1;
+    scan.xyz[cell] = p;
+    scan.range_m[cell] = range;
+    scan.time_offset_s[cell] = cloud.time_offset_s.empty() ? 0.0f : cloud.time_offset_s[i];
+    for (size_t c = 0; c < channels.size(); ++c) {
+      channels[c]->values[cell] = cloud.channels[c].values[i];
+    }
+  }
+  scan.stamp_ns = cloud.stamp_ns;
+  if (stats) *stats = counts;
+  return scan;
+}
+
+}  // namespace featsense::slam
