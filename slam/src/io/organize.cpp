@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -25,23 +26,47 @@ double half_spacing_at(const std::vector<double>& elevation_rad, size_t beam) {
   return 0.5 * std::abs(elevation_rad[beam] - elevation_rad[other]);
 }
 
-/// The beam (row) whose elevation is nearest to `elevation_rad`, or -1 when the point lies
-/// more than half a beam spacing above the highest or below the lowest beam.
-/// `beams_rad` is sorted from the highest to the lowest beam (SensorModel's order).
-int nearest_beam(const std::vector<double>& beams_rad, double elevation_rad) {
-  if (beams_rad.empty()) return -1;
-  const size_t last = beams_rad.size() - 1;
-  if (elevation_rad > beams_rad.front() + half_spacing_at(beams_rad, 0)) return -1;
-  if (elevation_rad < beams_rad.back() - half_spacing_at(beams_rad, last)) return -1;
-  // First beam at or below the point (the list is descending).
-  const auto below =
-      std::lower_bound(beams_rad.begin(), beams_rad.end(), elevation_rad, std::greater<double>());
-  if (below == beams_rad.begin()) return 0;
-  if (below == beams_rad.end()) return static_cast<int>(last);
-  const auto above = below - 1;
-  const bool above_nearer = (*above - elevation_rad) <= (elevation_rad - *below);
-  return static_cast<int>((above_nearer ? above : below) - beams_rad.begin());
-}
+/// The beam nearest to a point's elevation, found by slope z / horizontal distance (which
+/// grows with the elevation, so no arctangent per point): the beam boundaries are the
+/// slopes of the elevations halfway between neighbouring beams.
+class BeamLookup {
+ public:
+  /// `elevation_rad` from the highest beam to the lowest (SensorModel's order).
+  explicit BeamLookup(const std::vector<double>& elevation_rad) {
+    const size_t beams = elevation_rad.size();
+    if (beams == 0) return;
+    top_ = slope(elevation_rad.front() + half_spacing_at(elevation_rad, 0));
+    bottom_ = slope(elevation_rad.back() - half_spacing_at(elevation_rad, beams - 1));
+    for (size_t i = 0; i + 1 < beams; ++i) {
+      boundaries_.push_back(slope(0.5 * (elevation_rad[i] + elevation_rad[i + 1])));
+    }
+  }
+
+  /// The row of the beam nearest to the point, or -1 when it lies more than half a beam
+  /// spacing above the highest or below the lowest beam.
+  int row_of(const Eigen::Vector3f& p) const {
+    const double x = static_cast<double>(p.x()), y = static_cast<double>(p.y());
+    const double horizontal = std::sqrt(x * x + y * y);
+    const double s = static_cast<double>(p.z()) / horizontal;  // +-inf straight up / down
+    if (!(s <= top_ && s >= bottom_)) return -1;
+    // Boundaries descend; the number of them above the point is its row (a point exactly
+    // halfway goes to the upper beam).
+    const auto below =
+        std::lower_bound(boundaries_.begin(), boundaries_.end(), s, std::greater<double>());
+    return static_cast<int>(below - boundaries_.begin());
+  }
+
+ private:
+  static double slope(double elevation_rad) {
+    if (elevation_rad >= M_PI / 2) return std::numeric_limits<double>::infinity();
+    if (elevation_rad <= -M_PI / 2) return -std::numeric_limits<double>::infinity();
+    return std::tan(elevation_rad);
+  }
+
+  std::vector<double> boundaries_;
+  double top_ = 0.0;
+  double bottom_ = 0.0;
+};
 
 void check_sizes(const PointCloud& cloud) {
   const size_t n = cloud.size();
@@ -81,6 +106,7 @@ Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, Organi
   }
   OrganizeStats counts;
   counts.input_points = cloud.size();
+  const BeamLookup beams(by_ring ? std::vector<double>() : sensor.elevation_rad);
 
   Scan scan = Scan::allocate(sensor.beams, sensor.columns);
   std::vector<ScanChannel*> channels;
@@ -101,8 +127,7 @@ Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, Organi
         row = cloud.ring_counts_up ? sensor.beams - 1 - ring : ring;
       }
     } else {
-      const double horizontal = std::hypot(static_cast<double>(p.x()), static_cast<double>(p.y()));
-      row = nearest_beam(sensor.elevation_rad, std::atan2(static_cast<double>(p.z()), horizontal));
+      row = beams.row_of(p);
     }
     if (row < 0) {
       ++counts.dropped_outside;
