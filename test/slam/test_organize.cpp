@@ -156,11 +156,18 @@ TEST(Organize, ZeroNanAndInfinitePointsAreNotData) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
   PointCloud cloud;
-  cloud.xyz = {{0, 0, 0}, {nan, 1, 1}, {1, inf, 0}, {1, 1, -inf}, point_at(3, 0.0174533, 0)};
+  // Also coordinates whose norm overflows or underflows in float: no sensor measures them.
+  cloud.xyz = {{0, 0, 0},
+               {nan, 1, 1},
+               {1, inf, 0},
+               {1, 1, -inf},
+               {3e19f, 0, 0},
+               {1e-30f, 0, 0},
+               point_at(3, 0.0174533, 0)};
   OrganizeStats stats;
   const Scan scan = organize(cloud, sensor, &stats);
-  EXPECT_EQ(stats.input_points, 5u);
-  EXPECT_EQ(stats.dropped_invalid, 4u);
+  EXPECT_EQ(stats.input_points, 7u);
+  EXPECT_EQ(stats.dropped_invalid, 6u);
   EXPECT_EQ(scan.valid_count(), 1u);
   for (size_t i = 0; i < scan.size(); ++i) EXPECT_TRUE(scan.xyz[i].allFinite());
 }

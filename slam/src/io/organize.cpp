@@ -9,14 +9,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/point_validity.hpp"
+
 namespace featsense::slam {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-
-bool is_data(const Eigen::Vector3f& p) {
-  return p.allFinite() && !(p.x() == 0.0f && p.y() == 0.0f && p.z() == 0.0f);
-}
 
 /// Half the gap to the neighbouring beam beyond which a point at the edge of the fan is
 /// taken as outside it; a single-beam sensor gets half a degree.
@@ -116,7 +114,7 @@ Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, Organi
 
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.xyz[i];
-    if (!is_data(p)) {
+    if (!is_return(p)) {
       ++counts.dropped_invalid;
       continue;
     }
@@ -137,7 +135,7 @@ Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, Organi
     const float range =
         !cloud.range_m.empty() && std::isfinite(cloud.range_m[i]) && cloud.range_m[i] > 0.0f
             ? cloud.range_m[i]
-            : p.norm();
+            : return_range(p);
     if (scan.valid[cell]) {
       ++counts.dropped_collisions;
       if (scan.range_m[cell] <= range) continue;

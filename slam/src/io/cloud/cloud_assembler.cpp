@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 
+#include "io/point_validity.hpp"
+
 namespace featsense::slam::cloud {
 namespace {
 
@@ -15,10 +17,6 @@ int ring_of(double value) {
   if (!std::isfinite(value) || value < 0.0 || value > kMaxRing) return -1;
   const double whole = std::round(value);
   return whole == value ? static_cast<int>(whole) : -1;
-}
-
-bool is_data(const Eigen::Vector3f& p) {
-  return p.allFinite() && !(p.x() == 0.0f && p.y() == 0.0f && p.z() == 0.0f);
 }
 
 }  // namespace
@@ -235,7 +233,7 @@ bool rings_count_up(const PointCloud& cloud) {
   int lowest = std::numeric_limits<int>::max();
   int highest = -1;
   for (size_t i = 0; i < cloud.ring.size(); ++i) {
-    if (cloud.ring[i] < 0 || !is_data(cloud.xyz[i])) continue;
+    if (cloud.ring[i] < 0 || !is_return(cloud.xyz[i])) continue;
     lowest = std::min(lowest, cloud.ring[i]);
     highest = std::max(highest, cloud.ring[i]);
   }
@@ -244,7 +242,7 @@ bool rings_count_up(const PointCloud& cloud) {
   size_t count[2] = {0, 0};
   for (size_t i = 0; i < cloud.ring.size(); ++i) {
     const int ring = cloud.ring[i];
-    if ((ring != lowest && ring != highest) || !is_data(cloud.xyz[i])) continue;
+    if ((ring != lowest && ring != highest) || !is_return(cloud.xyz[i])) continue;
     const Eigen::Vector3d p = cloud.xyz[i].cast<double>();
     const size_t k = ring == highest ? 1 : 0;
     sum[k] += std::atan2(p.z(), std::hypot(p.x(), p.y()));

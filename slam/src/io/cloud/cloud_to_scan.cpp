@@ -7,13 +7,10 @@
 #include "featsense/slam/io/cloud_files.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "io/cloud/sensor_guess.hpp"
+#include "io/point_validity.hpp"
 
 namespace featsense::slam {
 namespace {
-
-bool is_data(const Eigen::Vector3f& p) {
-  return p.allFinite() && !(p.x() == 0.0f && p.y() == 0.0f && p.z() == 0.0f);
-}
 
 std::string preset_list() {
   std::string list;
@@ -85,14 +82,14 @@ Scan organized_to_scan(const DecodedCloud& decoded, const std::string& origin,
   for (size_t i = 0; i < scan.size(); ++i) {
     // Times and channels of empty cells as the file has them: the cell stays a cell.
     if (has_time) scan.time_offset_s[i] = cloud.time_offset_s[i];
-    if (!is_data(cloud.xyz[i])) {
+    if (!is_return(cloud.xyz[i])) {
       ++counts.dropped_invalid;
       continue;
     }
     scan.valid[i] = 1;
     scan.xyz[i] = cloud.xyz[i];
     const float range = has_range ? cloud.range_m[i] : 0.0f;
-    scan.range_m[i] = std::isfinite(range) && range > 0.0f ? range : cloud.xyz[i].norm();
+    scan.range_m[i] = std::isfinite(range) && range > 0.0f ? range : return_range(cloud.xyz[i]);
   }
   for (ScanChannel& c : scan.channels) {
     for (float& v : c.values) v = std::isfinite(v) ? v : 0.0f;
@@ -165,7 +162,7 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
   if (!cloud.ring.empty()) {
     int highest = -1;
     for (size_t i = 0; i < cloud.size(); ++i) {
-      if (is_data(cloud.xyz[i])) highest = std::max(highest, cloud.ring[i]);
+      if (is_return(cloud.xyz[i])) highest = std::max(highest, cloud.ring[i]);
     }
     if (const auto name = cloud::preset_for_rings(highest + 1)) {
       say("preset " + *name + " (rings up to " + std::to_string(highest) + ")");

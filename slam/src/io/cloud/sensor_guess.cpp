@@ -4,6 +4,8 @@
 #include <cmath>
 #include <exception>
 
+#include "io/point_validity.hpp"
+
 namespace featsense::slam::cloud {
 namespace {
 
@@ -19,10 +21,6 @@ constexpr RingPreset kRingPresets[] = {
 constexpr size_t kMaxSampledPoints = 20000;
 constexpr double kMinFitFraction = 0.9;
 constexpr double kMinBeamsHitFraction = 0.5;
-
-bool is_data(const Eigen::Vector3f& p) {
-  return p.allFinite() && !(p.x() == 0.0f && p.y() == 0.0f && p.z() == 0.0f);
-}
 
 double elevation_of(const Eigen::Vector3f& p) {
   const Eigen::Vector3d q = p.cast<double>();
@@ -68,11 +66,11 @@ std::optional<std::string> preset_with_beams(int beams) {
 std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
   std::vector<double> elevations;
   size_t data_points = 0;
-  for (const Eigen::Vector3f& p : cloud.xyz) data_points += is_data(p) ? 1 : 0;
+  for (const Eigen::Vector3f& p : cloud.xyz) data_points += is_return(p) ? 1 : 0;
   const size_t step = std::max<size_t>(1, data_points / kMaxSampledPoints);
   size_t seen = 0;
   for (const Eigen::Vector3f& p : cloud.xyz) {
-    if (is_data(p) && seen++ % step == 0) elevations.push_back(elevation_of(p));
+    if (is_return(p) && seen++ % step == 0) elevations.push_back(elevation_of(p));
   }
   if (elevations.empty()) return std::nullopt;
 
@@ -114,7 +112,7 @@ std::optional<double> row_elevation(const PointCloud& cloud, int width, int row,
   scratch.clear();
   const size_t start = static_cast<size_t>(row) * static_cast<size_t>(width);
   for (size_t i = start; i < start + static_cast<size_t>(width) && i < cloud.xyz.size(); ++i) {
-    if (is_data(cloud.xyz[i])) scratch.push_back(elevation_of(cloud.xyz[i]));
+    if (is_return(cloud.xyz[i])) scratch.push_back(elevation_of(cloud.xyz[i]));
   }
   if (scratch.empty()) return std::nullopt;
   auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
@@ -125,7 +123,7 @@ std::optional<double> row_elevation(const PointCloud& cloud, int width, int row,
 bool row_has_data(const PointCloud& cloud, int width, int row) {
   const size_t start = static_cast<size_t>(row) * static_cast<size_t>(width);
   for (size_t i = start; i < start + static_cast<size_t>(width) && i < cloud.xyz.size(); ++i) {
-    if (is_data(cloud.xyz[i])) return true;
+    if (is_return(cloud.xyz[i])) return true;
   }
   return false;
 }
