@@ -18,6 +18,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "common/pcd_test_writer.hpp"
 #include "common/test_data.hpp"
 #include "featsense/slam/io/cloud_files.hpp"
 #include "featsense/slam/io/readers.hpp"
@@ -27,46 +28,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// ---------------------------------------------------------------------------------------
-// A test-side PCD writer, independent of the production one: fields of any type and count,
-// ascii / binary / binary_compressed (LZF literal runs, which any LZF decoder must accept,
-// or liblzf's compressor).
-
-struct TestField {
-  std::string name;
-  char type;  // F U I
-  int size;   // bytes
-  int count = 1;
-};
-
-enum class Mode { kAscii, kBinary, kCompressed, kCompressedLzf };
-
-void put_value(std::string& out, const TestField& f, double v) {
-  uint8_t bytes[8];
-  if (f.type == 'F' && f.size == 4) {
-    const float x = static_cast<float>(v);
-    std::memcpy(bytes, &x, 4);
-  } else if (f.type == 'F') {
-    std::memcpy(bytes, &v, 8);
-  } else if (f.type == 'U') {
-    const uint64_t x = static_cast<uint64_t>(v);
-    std::memcpy(bytes, &x, 8);  // little-endian host: the low bytes first
-  } else {
-    const int64_t x = static_cast<int64_t>(v);
-    std::memcpy(bytes, &x, 8);
-  }
-  out.append(reinterpret_cast<const char*>(bytes), static_cast<size_t>(f.size));
-}
-
-std::string lzf_literal_runs(const std::string& plain) {
-  std::string out;
-  for (size_t i = 0; i < plain.size(); i += 32) {
-    const size_t n = std::min<size_t>(32, plain.size() - i);
-    out += static_cast<char>(n - 1);
-    out += plain.substr(i, n);
-  }
-  return out;
-}
+using test::Mode;
+using test::TestField;
 
 std::string lzf_library(const std::string& plain) {
   std::string out(plain.size() + plain.size() / 16 + 64, '\0');
@@ -77,59 +40,11 @@ std::string lzf_library(const std::string& plain) {
   return out;
 }
 
-/// values[i] holds point i's values, field after field, `count` values each.
+/// The test writer with liblzf's compressor for Mode::kCompressedLzf.
 std::string test_pcd(const std::vector<TestField>& fields,
                      const std::vector<std::vector<double>>& values, Mode mode, int width = -1,
-                     int height = 1, const std::string& extra_header = "") {
-  std::ostringstream h;
-  h << "# .PCD v0.7 - test\nVERSION 0.7\nFIELDS";
-  for (const auto& f : fields) h << " " << f.name;
-  h << "\nSIZE";
-  for (const auto& f : fields) h << " " << f.size;
-  h << "\nTYPE";
-  for (const auto& f : fields) h << " " << f.type;
-  h << "\nCOUNT";
-  for (const auto& f : fields) h << " " << f.count;
-  if (width < 0) width = static_cast<int>(values.size());
-  h << "\nWIDTH " << width << "\nHEIGHT " << height << "\nVIEWPOINT 0 0 0 1 0 0 0\n"
-    << extra_header << "POINTS " << values.size() << "\nDATA "
-    << (mode == Mode::kAscii    ? "ascii"
-        : mode == Mode::kBinary ? "binary"
-                                : "binary_compressed")
-    << "\n";
-  std::string out = h.str();
-  if (mode == Mode::kAscii) {
-    std::ostringstream data;
-    data.precision(17);
-    for (const auto& point : values) {
-      for (size_t k = 0; k < point.size(); ++k) data << (k ? " " : "") << point[k];
-      data << "\n";
-    }
-    return out + data.str();
-  }
-  if (mode == Mode::kBinary) {
-    for (const auto& point : values) {
-      size_t k = 0;
-      for (const auto& f : fields) {
-        for (int c = 0; c < f.count; ++c) put_value(out, f, point[k++]);
-      }
-    }
-    return out;
-  }
-  std::string plain;
-  size_t first = 0;
-  for (const auto& f : fields) {
-    for (const auto& point : values) {
-      for (int c = 0; c < f.count; ++c) put_value(plain, f, point[first + static_cast<size_t>(c)]);
-    }
-    first += static_cast<size_t>(f.count);
-  }
-  const std::string packed =
-      mode == Mode::kCompressed ? lzf_literal_runs(plain) : lzf_library(plain);
-  const uint32_t sizes[2] = {static_cast<uint32_t>(packed.size()),
-                             static_cast<uint32_t>(plain.size())};
-  out.append(reinterpret_cast<const char*>(sizes), 8);
-  return out + packed;
+                     int height = 1) {
+  return test::pcd_bytes(fields, values, mode, width, height, lzf_library);
 }
 
 void write_file(const fs::path& path, const std::string& bytes) {
@@ -230,6 +145,36 @@ TEST(PcdReader, TimeUnitsAndAbsoluteTimes) {
   EXPECT_NEAR(ns.cloud.time_offset_s[0], 0.002f, 1e-6f);
 }
 
+TEST(PcdReader, TimesThatCannotBeWithinTheRevolutionAreDropped) {
+  // `time` in float seconds spanning 5 s over a full turn: not one revolution of 0.1 s.
+  const config::SensorModel vlp16 = config::sensor_preset("vlp16");
+  std::vector<std::vector<double>> points;
+  for (int c = 0; c < 1800; c += 10) {
+    const double a = -2 * M_PI * c / 1800;
+    points.push_back({5 * std::cos(a), 5 * std::sin(a), 0.0, 0.0, 5.0 * c / 1800});
+  }
+  const DecodedCloud d = decode_pcd(
+      test_pcd({{"x", 'F', 4}, {"y", 'F', 4}, {"z", 'F', 4}, {"ring", 'U', 1}, {"time", 'F', 4}},
+               points, Mode::kBinary),
+      "slow.pcd");
+  std::vector<std::string> warnings;
+  const Scan scan = cloud_to_scan(d, vlp16, "slow.pcd", nullptr, &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("more than two of 100.0"), std::string::npos) << warnings[0];
+  for (float t : scan.time_offset_s) EXPECT_EQ(t, 0.0f);
+
+  // The same over one revolution is kept.
+  for (auto& p : points) p[4] /= 50.0;
+  const DecodedCloud ok = decode_pcd(
+      test_pcd({{"x", 'F', 4}, {"y", 'F', 4}, {"z", 'F', 4}, {"ring", 'U', 1}, {"time", 'F', 4}},
+               points, Mode::kBinary),
+      "ok.pcd");
+  warnings.clear();
+  const Scan kept = cloud_to_scan(ok, vlp16, "ok.pcd", nullptr, &warnings);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_FLOAT_EQ(kept.time_offset_s[kept.index(15, 900)], static_cast<float>(0.1 * 900 / 1800));
+}
+
 TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
   // 4 rows x 6 columns at elevations +3, +1, -1, -3 degrees, one cell empty (NaN).
   const double elevations_deg[4] = {3, 1, -1, -3};
@@ -249,7 +194,9 @@ TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
                          10 * std::sin(e), static_cast<double>(row * 10 + c)});
       }
     }
-    const DecodedCloud d = decode_pcd(test_pcd(fields, cells, Mode::kBinary, 6, 4), "org.pcd");
+    // ascii spells the empty cell "nan", as PCL writes it.
+    const Mode mode = bottom_first ? Mode::kAscii : Mode::kCompressed;
+    const DecodedCloud d = decode_pcd(test_pcd(fields, cells, mode, 6, 4), "org.pcd");
     ASSERT_TRUE(d.organized());
     std::string why;
     const config::SensorModel sensor = choose_sensor(d, SourceOptions{}, "org.pcd", &why);

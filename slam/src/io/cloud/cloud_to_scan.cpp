@@ -54,9 +54,10 @@ void check_times(Scan& scan, double rate_hz, const std::string& origin,
   if (warnings) {
     warnings->push_back(origin + ": per-point times span " + std::to_string(span_s * 1e3) +
                         " ms over " + std::to_string(static_cast<int>(columns_used * 100)) +
-                        " % of the columns, " + (too_short ? "far less" : "more") +
-                        " than a revolution of " + std::to_string(revolution_s * 1e3) +
-                        " ms: not times within the scan (per packet?); set to 0");
+                        " % of the columns, " +
+                        (too_short ? "far less than a revolution of " : "more than two of ") +
+                        std::to_string(revolution_s * 1e3) + " ms: not times within the scan" +
+                        (too_short ? " (per packet?)" : " (other units?)") + "; set to 0");
   }
 }
 
