@@ -150,6 +150,15 @@ TEST(PlyReader, IntegerCoordinatesAreAccepted) {
   EXPECT_EQ(d.cloud.xyz[0], Eigen::Vector3f(-7, 300, 9));
 }
 
+TEST(PlyReader, GarbageTimesBecomeZero) {
+  // Found by fuzzing: a double time of 1e300 gave an infinite float offset.
+  const DecodedCloud d =
+      decode_ply(test_ply({{"float", "x"}, {"float", "y"}, {"float", "z"}, {"double", "time"}},
+                          {{1, 2, 3, 1e300}, {1, 2, 4, 0}, {1, 2, 5, -1e300}}, Format::kBig),
+                 "garbage.ply");
+  for (float t : d.cloud.time_offset_s) EXPECT_EQ(t, 0.0f);
+}
+
 TEST(PlyReader, UnorganizedCloudGoesThroughOrganize) {
   // Points on the beams of an HDL-32 with their ring (Velodyne: ring 0 lowest).
   const config::SensorModel hdl32 = config::sensor_preset("hdl32");

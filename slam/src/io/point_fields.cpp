@@ -67,8 +67,9 @@ PointTimes point_times_to_offsets(const std::vector<double>& stored, bool intege
   }
   times.offset_s.reserve(stored.size());
   for (double v : stored) {
-    times.offset_s.push_back(std::isfinite(v) ? static_cast<float>((v - origin) * to_seconds)
-                                              : 0.0f);
+    // Offsets beyond float's range (garbage, not times) become 0 like non-finite ones.
+    const float offset = static_cast<float>((v - origin) * to_seconds);
+    times.offset_s.push_back(std::isfinite(offset) ? offset : 0.0f);
   }
   return times;
 }

@@ -38,8 +38,8 @@ struct PointTimes {
 /// nanoseconds (Ouster `t`: u32 ns since the frame start); floating-point fields count seconds
 /// (Velodyne `time`), except values above 1e15, which only nanoseconds since 1970 reach.
 /// Times above 1e8 s (after 1973) are absolute: they become offsets from the earliest one,
-/// returned as absolute_stamp_ns (double precision: within ~0.3 us). Non-finite values
-/// become 0.
+/// returned as absolute_stamp_ns (double precision: within ~0.3 us). Non-finite values, and
+/// offsets beyond float's range, become 0.
 PointTimes point_times_to_offsets(const std::vector<double>& stored, bool integer_field);
 
 }  // namespace featsense::slam
