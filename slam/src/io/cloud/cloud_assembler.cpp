@@ -223,7 +223,8 @@ DecodedCloud CloudAssembler::finish(std::string format, int width, int height) {
     cloud_.ring.resize(stored_ring_.size());
     std::transform(stored_ring_.begin(), stored_ring_.end(), cloud_.ring.begin(), ring_of);
     std::vector<double>().swap(stored_ring_);
-    cloud_.ring_counts_up = rings_count_up(cloud_);
+    // Organized clouds place points by row, not ring: no need to measure the direction.
+    if (height <= 1) cloud_.ring_counts_up = rings_count_up(cloud_);
   }
   decoded.cloud = std::move(cloud_);
   return decoded;
