@@ -228,19 +228,31 @@ TEST(ScanFolder, SimulatedSequence) {
   EXPECT_EQ(tag_of(scans[1]), 1);
   EXPECT_EQ(source->stats().frames_skipped, 1u);
 
-  // An inline sensor of another shape: the 16-row frames do not fit its 8 beams.
+  // An inline sensor of another shape: the 16-row frames do not fit its 8 beams, and a
+  // folder without a single readable frame is an error.
   write_text(dir / "sequence.yaml",
              "format: featsense-sequence\nversion: 1\n"
              "sensor: {name: sim-8, beams: 8, columns: 1800, rate_hz: 10, "
              "vfov_deg: [7, -7], beam_origin_offset_m: 0, min_range_m: 0.1, max_range_m: 50}\n"
              "frames:\n  - {file: frame_000000.pcd, stamp_ns: 5}\n");
-  const auto inline_sensor = open_scan_folder(dir.string(), {});
-  EXPECT_EQ(inline_sensor->info().sensor.name, "sim-8");
-  EXPECT_EQ(inline_sensor->info().sensor.beams, 8);
-  EXPECT_FALSE(inline_sensor->next());
-  EXPECT_NE(inline_sensor->stats().warnings[0].find("16 rows for a sensor of 8 beams"),
+  EXPECT_NE(error_of(dir).find(
+                "no readable scan; the last error: " + (dir / "frame_000000.pcd").string() +
+                ": an organized cloud of 16 rows for a sensor of 8 beams"),
             std::string::npos)
-      << inline_sensor->stats().warnings[0];
+      << error_of(dir);
+  write_text(dir / "sequence.yaml",
+             "format: featsense-sequence\nversion: 1\n"
+             "sensor: {name: sim-16, beams: 16, columns: 1800, rate_hz: 10, "
+             "vfov_deg: [15, -15], beam_origin_offset_m: 0, min_range_m: 0.1, max_range_m: 50}\n"
+             "frames:\n  - {file: frame_000000.pcd, stamp_ns: 5}\n");
+  const auto inline_sensor = open_scan_folder(dir.string(), {});
+  EXPECT_EQ(inline_sensor->info().sensor.name, "sim-16");
+  EXPECT_EQ(inline_sensor->info().fields,
+            (std::vector<std::string>{"x", "y", "z", "range", "t", "ring"}));
+  const std::optional<Scan> only = inline_sensor->next();
+  ASSERT_TRUE(only);
+  EXPECT_EQ(only->stamp_ns, 5);
+  EXPECT_FALSE(inline_sensor->next());
 
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"format: other\nversion: 1\nsensor: vlp16\nframes: []\n", "format must be"},

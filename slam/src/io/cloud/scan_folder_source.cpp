@@ -86,12 +86,7 @@ class ScanFolderSource final : public ScanSource {
         scan = read_frame(index, &file_stamp);
         if (!scan) continue;
       }
-      const Frame& frame = frames_[index];
-      scan->stamp_ns =
-          frame.stamp_ns ? *frame.stamp_ns
-          : file_stamp
-              ? *file_stamp
-              : static_cast<int64_t>(std::llround(static_cast<double>(index) * 1e9 / rate_hz_));
+      scan->stamp_ns = stamp_of(index, file_stamp);
       scan->sequence = index;
       count_frame();
       return scan;
@@ -102,6 +97,14 @@ class ScanFolderSource final : public ScanSource {
   const SourceInfo& info() const override { return info_; }
 
  private:
+  /// The stamp from the frame's name, times.txt or sequence.yaml; else the one the file
+  /// states; else the frame's index over the rate.
+  int64_t stamp_of(size_t index, const std::optional<int64_t>& file_stamp) const {
+    if (frames_[index].stamp_ns) return *frames_[index].stamp_ns;
+    if (file_stamp) return *file_stamp;
+    return static_cast<int64_t>(std::llround(static_cast<double>(index) * 1e9 / rate_hz_));
+  }
+
   /// The frame as a Scan, or nullopt with a counted warning when it cannot be read.
   std::optional<Scan> read_frame(size_t index, std::optional<int64_t>* file_stamp) {
     const std::string origin = frames_[index].file.string();
@@ -137,9 +140,11 @@ class ScanFolderSource final : public ScanSource {
       warn("sensor.preset " + options.sensor_preset + " ignored: " + index.string() +
            " describes the sensor");
     }
+    if (frames_.empty()) throw InputError(index.string() + ": lists no frames");
+    open_first_cloud(options, sequence.sensor);
+    info_.format = "simulated";
     info_.detail =
         std::to_string(frames_.size()) + " simulated frames, sensor " + sequence.sensor.name;
-    if (frames_.empty()) throw InputError(index.string() + ": lists no frames");
   }
 
   void open_scans(const SourceOptions& options) {
@@ -179,7 +184,7 @@ class ScanFolderSource final : public ScanSource {
       info_.detail =
           std::to_string(frames_.size()) + " KITTI .bin scans, sensor " + info_.sensor.name;
     } else {
-      open_first_cloud(options);
+      open_first_cloud(options, std::nullopt);
     }
     rate_hz_ = info_.sensor.rate_hz;
     if (!frames_.front().stamp_ns) stamps_from_times_txt();
@@ -226,38 +231,46 @@ class ScanFolderSource final : public ScanSource {
     for (size_t i = 0; i < frames_.size(); ++i) frames_[i].stamp_ns = stamp((*seconds)[numbers[i]]);
   }
 
-  /// PCD and PLY folders: the first readable frame decides the sensor (and is kept). A
-  /// frame that cannot be decoded is skipped; a sensor that cannot be chosen fails at once,
-  /// as it would for every frame.
-  void open_first_cloud(const SourceOptions& options) {
+  /// PCD and PLY folders: the first readable frame tells the fields and, unless `known`,
+  /// decides the sensor; it is kept for next(). A frame that cannot be read is skipped, and
+  /// a folder without any readable frame is an error. A sensor that cannot be chosen fails
+  /// at once, as it would for every frame.
+  void open_first_cloud(const SourceOptions& options,
+                        const std::optional<config::SensorModel>& known) {
+    std::string last_error;
     for (size_t i = 0; i < frames_.size(); ++i) {
       const std::string origin = frames_[i].file.string();
       DecodedCloud decoded;
       try {
         decoded = cloud::decode_cloud_file(frames_[i].file, format_);
       } catch (const InputError& e) {
-        if (i + 1 == frames_.size()) {
-          throw InputError(info_.path + ": no readable scan; the last error: " + e.what());
-        }
-        skip_frame(std::string("frame skipped: ") + e.what());
+        last_error = e.what();
+        skip_frame("frame skipped: " + last_error);
         continue;
       }
-      std::string why;
-      info_.sensor = choose_sensor(decoded, options, origin, &why);
-      info_.format = decoded.format;
-      info_.fields = decoded.fields;
-      for (const std::string& w : decoded.warnings) warn(origin + ": " + w);
+      std::string why = "from " + (folder_ / "sequence.yaml").string();
+      info_.sensor = known ? *known : choose_sensor(decoded, options, origin, &why);
       OrganizeStats stats;
       std::vector<std::string> warnings;
-      first_ = cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings);
+      try {
+        first_ = cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings);
+      } catch (const InputError& e) {
+        last_error = e.what();
+        skip_frame("frame skipped: " + last_error);
+        continue;
+      }
+      for (const std::string& w : decoded.warnings) warn(origin + ": " + w);
       cloud::describe(stats, &warnings, origin);
       for (const std::string& w : warnings) warn(w);
-      first_stamp_ = decoded.stamp_ns;
-      first_index_ = i;
+      info_.format = decoded.format;
+      info_.fields = decoded.fields;
       info_.detail =
           std::to_string(frames_.size()) + " " + decoded.format + " scans, sensor " + why;
+      first_stamp_ = decoded.stamp_ns;
+      first_index_ = i;
       return;
     }
+    throw InputError(info_.path + ": no readable scan; the last error: " + last_error);
   }
 
   fs::path folder_;
