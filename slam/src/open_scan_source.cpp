@@ -6,7 +6,6 @@
 #include <fstream>
 #include <string_view>
 
-#include "featsense/config/config_error.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "featsense/slam/scan_source.hpp"
 
@@ -96,16 +95,6 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
 }
 
 }  // namespace
-
-config::SensorModel sensor_for(const SourceOptions& options, const std::string& fallback_preset) {
-  const std::string name = options.sensor_preset == "auto" ? fallback_preset
-                                                           : options.sensor_preset;
-  try {
-    return config::sensor_preset(name);
-  } catch (const config::ConfigError& e) {
-    throw InputError(std::string("sensor.preset: ") + e.what());
-  }
-}
 
 std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
                                              const SourceOptions& options) {

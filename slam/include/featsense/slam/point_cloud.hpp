@@ -15,6 +15,9 @@ struct PointCloud {
   std::vector<int> ring;             ///< beam index per point, if the format has one
   bool ring_counts_up = true;        ///< Velodyne: ring 0 is the lowest beam; Ouster: highest
   std::vector<float> time_offset_s;  ///< per point after stamp_ns, if the format has one
+  /// Per point, metres, where the format stores the sensor's own range; else empty and
+  /// organize() uses |xyz|.
+  std::vector<float> range_m;
   std::vector<ScanChannel> channels; ///< per point, same names as in Scan
   int64_t stamp_ns = 0;
 

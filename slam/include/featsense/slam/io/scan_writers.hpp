@@ -1,11 +1,19 @@
 #pragma once
 /// Writes single scans to files that other tools open (`featsense convert`).
 
+#include <stdexcept>
 #include <string>
 
 #include "featsense/slam/scan.hpp"
 
 namespace featsense::slam {
+
+/// Thrown by the writers below when the file cannot be written (missing folder, no
+/// permission, disk full); the message names the path.
+class WriteError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 /// Binary PCD v0.7, organized (WIDTH = cols, HEIGHT = rows) with every cell, invalid ones as
 /// NaN; fields x y z range t (time offset, s) ring, then every channel by name. Readable by

@@ -1,0 +1,45 @@
+#pragma once
+// Which sensor recorded a cloud that does not say: from its ring count, from the elevations
+// its points lie on, or measured from an organized cloud's rows.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/point_cloud.hpp"
+
+namespace featsense::slam::cloud {
+
+/// Every built-in preset, parsed once.
+const std::vector<config::SensorModel>& builtin_presets();
+
+/// The smallest of vlp16 (16), hdl32 (32), hdl64 (64), os1-128 (128) with at least `rings`
+/// beams, or nullopt beyond 128.
+std::optional<std::string> preset_for_rings(int rings);
+
+/// The preset with exactly `beams` beams among those four, or nullopt.
+std::optional<std::string> preset_with_beams(int beams);
+
+/// The preset on whose beam elevations at least 90 % of the cloud's points lie (within a
+/// quarter of its smallest beam spacing), with points on at least half of its beams; nullopt
+/// when no preset or more than one fits that well. Real sensors with per-unit calibrations
+/// often fit none, which is the safe answer: the caller then asks the user.
+std::optional<std::string> preset_from_elevations(const PointCloud& cloud);
+
+/// The elevation of each row of an organized cloud (row 0 first), radians: the median over
+/// the row's points; nullopt for rows without any.
+std::vector<std::optional<double>> row_elevations(const PointCloud& cloud, int width, int height);
+
+/// Whether the first row with points lies lower than the last one (the file lists the lowest
+/// beam first, where Scan wants the highest).
+bool lowest_row_first(const std::vector<std::optional<double>>& elevation_rad);
+/// The same for an organized cloud, measuring only those two rows.
+bool lowest_row_first(const PointCloud& cloud, int width, int height);
+
+/// A sensor model measured from row elevations (row 0 highest): rows without points are
+/// interpolated, and the list is made non-increasing. Needs two measured rows.
+std::optional<config::SensorModel> sensor_from_rows(
+    const std::vector<std::optional<double>>& elevation_rad, int columns);
+
+}  // namespace featsense::slam::cloud
