@@ -193,7 +193,8 @@ TEST(RosbagOuster, PacketsOfAnotherSizeAreCountedAndIgnored) {
 TEST(RosbagOuster, UnorganizedCloudIsOrganizedByRing) {
   // A VLP-16-like cloud: rings numbered from the lowest beam (-15 deg) up in 2 deg steps,
   // one point per ring in every 7th of the preset's 1800 columns, at the column's centre
-  // (azimuth measured clockwise from +x).
+  // (azimuth measured clockwise from +x; column c is centred on c * 2 pi / columns, as
+  // column_of() and Ouster's measurement ids have it).
   const auto dir = test::scratch_dir("rosbag_unorganized_organize");
   const int columns = 1800;
   test::TestCloud cloud;
@@ -211,7 +212,7 @@ TEST(RosbagOuster, UnorganizedCloudIsOrganizedByRing) {
   for (int col = 0; col < columns; col += 7) {
     for (int ring = 0; ring < 16; ++ring) {
       const double elevation = (-15.0 + 2.0 * ring) * M_PI / 180.0;
-      const double clockwise = (col + 0.5) * 2.0 * M_PI / columns;
+      const double clockwise = col * 2.0 * M_PI / columns;
       const double range = 4.0 + 0.01 * ring;
       const Eigen::Vector3d p =
           range * Eigen::Vector3d(std::cos(elevation) * std::cos(-clockwise),
