@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 
@@ -13,13 +14,18 @@
 
 namespace {
 
-/// For "featsense inof": CLI11 says only that the argument was not expected.
-std::string subcommand_hint(const CLI::App& app, const std::vector<std::string>& extras) {
-  if (extras.empty()) return "";
+std::vector<std::string> subcommand_names(const CLI::App& app) {
   std::vector<std::string> names;
   for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
-  const std::string match = featsense::config::closest_match(extras.front(), names);
-  return match.empty() ? "" : " (did you mean '" + match + "'?)";
+  return names;
+}
+
+/// For "featsense inof": CLI11 would only say that a subcommand is required.
+std::string unknown_command_message(const CLI::App& app, const std::string& word) {
+  std::string message = "unknown command '" + word + "'";
+  const std::string match = featsense::config::closest_match(word, subcommand_names(app));
+  if (!match.empty()) message += " (did you mean '" + match + "'?)";
+  return message + "; see featsense --help";
 }
 
 int fail(const std::string& message, int code) {
@@ -38,7 +44,20 @@ int main(int argc, char** argv) {
   featsense::app::CliContext context;
   context.add_options(app);
   const std::vector<featsense::app::Command> commands = {
-      featsense::app::register_info(app, context), featsense::app::register_convert(app, context)};
+      featsense::app::register_info(app, context), featsense::app::register_convert(app, context),
+      featsense::app::register_bench(app, context)};
+
+  // Global options are parsed wherever they stand; say so in every subcommand's help.
+  for (const auto& command : commands) {
+    command.parser->footer(
+        "Global options (before or after the command): -q,--quiet  -c,--config FILE  "
+        "--set KEY=VALUE (repeatable); see featsense --help");
+  }
+  const std::vector<std::string> names = subcommand_names(app);
+  if (argc > 1 && argv[1][0] != '-' &&
+      std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+    return fail(unknown_command_message(app, argv[1]), 2);
+  }
 
   try {
     app.parse(argc, argv);
@@ -46,8 +65,6 @@ int main(int argc, char** argv) {
     for (const auto& command : commands) {
       if (command.parser->parsed()) command.run();
     }
-  } catch (const CLI::ExtrasError& e) {
-    return fail(std::string(e.what()) + subcommand_hint(app, app.remaining()), 2);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

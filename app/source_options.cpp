@@ -24,9 +24,12 @@ void InputOptions::add_to(CLI::App& command, bool input_optional) {
 std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& config) const {
   if (input.empty()) {
     slam::BoxRoomSettings settings = slam::default_box_room();
-    if (config.sensor.preset != "auto")
+    if (config.sensor.preset != "auto") {
       settings.sensor = config::sensor_preset(config.sensor.preset);
-    return slam::make_box_room_source(settings);
+    }
+    return slam::with_range_limits(slam::make_box_room_source(settings),
+                                   config.sensor.min_range_m.value_or(settings.sensor.min_range_m),
+                                   config.sensor.max_range_m.value_or(settings.sensor.max_range_m));
   }
   slam::SourceOptions options;
   options.meta_path = meta_path;

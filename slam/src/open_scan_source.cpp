@@ -101,8 +101,13 @@ std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
   std::unique_ptr<ScanSource> source = open_by_content(input, options);
   const config::SensorModel& sensor = source->info().sensor;
   const double min_m = options.min_range_m.value_or(sensor.min_range_m);
-  const double max_m = options.max_range_m.value_or(sensor.max_range_m > 0.0 ? sensor.max_range_m
-                                                                             : 1.0e9);
+  const double max_m =
+      options.max_range_m.value_or(sensor.max_range_m > 0.0 ? sensor.max_range_m : 1.0e9);
+  return with_range_limits(std::move(source), min_m, max_m);
+}
+
+std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source, double min_m,
+                                              double max_m) {
   return std::make_unique<RangeLimitedSource>(std::move(source), min_m, max_m);
 }
 

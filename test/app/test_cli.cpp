@@ -42,8 +42,9 @@ TEST(Cli, InfoOnTheBuiltInExampleReportsItsShape) {
 }
 
 TEST(Cli, RangeLimitsFromTheConfigDropPoints) {
-  // The box room is 20 x 20 x 4 m: a 3 m limit keeps only the floor and ceiling near the sensor.
-  const CommandResult r = run_featsense("info --quiet --set sensor.max_range=3 --json -");
+  // The box room is 20 x 20 x 4 m, the sensor 1.5 m above the floor and 8 m or more from the
+  // walls: a 6 m limit keeps only the floor below the steeper beams.
+  const CommandResult r = run_featsense("info --quiet --set sensor.max_range=6 --json -");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json info = nlohmann::json::parse(r.output);
   EXPECT_LT(info["valid_points"]["max"].get<double>(), 0.6 * 128 * 1024);

@@ -70,6 +70,11 @@ struct SourceOptions {
   std::optional<double> max_range_m;     ///< config key sensor.max_range (else the sensor's)
 };
 
+/// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the
+/// sensor) and non-finite points are invalid in every scan it hands out.
+std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source, double min_m,
+                                              double max_m);
+
 /// Opens a recording, detecting its format from the content: an Ouster pcap, a ROS1 bag, a
 /// PCD or PLY file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense simulate`.
 /// Returned scans already have the range limits applied. Throws InputError.
