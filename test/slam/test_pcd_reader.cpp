@@ -78,11 +78,12 @@ const std::vector<TestField> kMixedFields = {
 std::vector<std::vector<double>> mixed_points(int n) {
   std::mt19937 random(3);
   std::uniform_real_distribution<float> coordinate(-20.0f, 20.0f);
+  // Coordinates that are floats already, so that the file's float32 x y z hold them exactly.
+  auto next = [&] { return static_cast<double>(coordinate(random)); };
   std::vector<std::vector<double>> points;
   for (int i = 0; i < n; ++i) {
-    points.push_back({coordinate(random), coordinate(random), coordinate(random), 0.5, -0.5, 1.0,
-                      static_cast<double>(i * 7 % 65536), 0, static_cast<double>(i % 16),
-                      static_cast<double>(i) * 1000.0});
+    points.push_back({next(), next(), next(), 0.5, -0.5, 1.0, static_cast<double>(i * 7 % 65536), 0,
+                      static_cast<double>(i % 16), static_cast<double>(i) * 1000.0});
   }
   return points;
 }
@@ -187,7 +188,8 @@ TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
       for (int c = 0; c < 6; ++c) {
         const double e = elevations_deg[row] * M_PI / 180.0, a = -2.0 * M_PI * c / 6;
         if (row == 1 && c == 2) {
-          cells.push_back({NAN, NAN, NAN, 0});
+          const double nan = std::numeric_limits<double>::quiet_NaN();
+          cells.push_back({nan, nan, nan, 0});
           continue;
         }
         cells.push_back({10 * std::cos(e) * std::cos(a), 10 * std::cos(e) * std::sin(a),
@@ -244,7 +246,7 @@ std::vector<double> row_elevations_deg(const Scan& scan) {
       e.push_back(std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / M_PI);
     }
     if (e.empty()) {
-      out.push_back(NAN);
+      out.push_back(std::numeric_limits<double>::quiet_NaN());
       continue;
     }
     std::nth_element(e.begin(), e.begin() + static_cast<long>(e.size() / 2), e.end());
