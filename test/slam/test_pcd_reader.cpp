@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <unordered_map>
@@ -222,6 +223,50 @@ TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
     EXPECT_NEAR(sensor.elevation_rad[0], 3 * M_PI / 180, 1e-6);
     EXPECT_NEAR(sensor.elevation_rad[3], -3 * M_PI / 180, 1e-6);
   }
+}
+
+/// An organized cloud of `beams` rows x 8 columns on `sensor`'s beams, rows listed in
+/// `rows_with_points` only.
+DecodedCloud organized_on(const config::SensorModel& sensor, const std::vector<int>& rows) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<double>> cells;
+  for (int r = 0; r < sensor.beams; ++r) {
+    const bool used = std::find(rows.begin(), rows.end(), r) != rows.end();
+    for (int c = 0; c < 8; ++c) {
+      const double e = sensor.elevation_rad[static_cast<size_t>(r)], a = -2 * M_PI * c / 8;
+      cells.push_back(used ? std::vector<double>{10 * std::cos(e) * std::cos(a),
+                                                 10 * std::cos(e) * std::sin(a), 10 * std::sin(e)}
+                           : std::vector<double>{nan, nan, nan});
+    }
+  }
+  return decode_pcd(test_pcd({{"x", 'F', 4}, {"y", 'F', 4}, {"z", 'F', 4}}, cells, Mode::kBinary, 8,
+                             sensor.beams),
+                    "organized.pcd");
+}
+
+TEST(PcdReader, OrganizedCloudSensorFromItsRows) {
+  const config::SensorModel os1_64 = config::sensor_preset("os1-64");
+  std::vector<int> all(64);
+  std::iota(all.begin(), all.end(), 0);
+  std::string why;
+  // Rows on the OS1-64's beams: that preset, not the HDL-64 that 64 rows alone suggest.
+  EXPECT_EQ(choose_sensor(organized_on(os1_64, all), SourceOptions{}, "o", &why).name, "os1-64")
+      << why;
+  // Rows on no preset's beams: elevations measured.
+  config::SensorModel odd = os1_64;
+  for (double& e : odd.elevation_rad) e *= 0.8;
+  const config::SensorModel measured = choose_sensor(organized_on(odd, all), SourceOptions{}, "o");
+  EXPECT_EQ(measured.beams, 64);
+  EXPECT_EQ(measured.columns, 8);
+  for (size_t r = 0; r < 64; ++r)
+    EXPECT_NEAR(measured.elevation_rad[r], odd.elevation_rad[r], 1e-6);
+  // Too few rows with points to measure: the preset with that many beams.
+  EXPECT_EQ(choose_sensor(organized_on(odd, {3, 40}), SourceOptions{}, "o", &why).name, "hdl64")
+      << why;
+  // A preset given that does not have one beam per row.
+  SourceOptions options;
+  options.sensor_preset = "vlp16";
+  EXPECT_THROW(choose_sensor(organized_on(os1_64, all), options, "o"), InputError);
 }
 
 TEST(PcdReader, OlderHeaderWithoutVersion) {
