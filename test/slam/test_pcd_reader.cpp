@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <unordered_map>
@@ -78,11 +79,12 @@ const std::vector<TestField> kMixedFields = {
 std::vector<std::vector<double>> mixed_points(int n) {
   std::mt19937 random(3);
   std::uniform_real_distribution<float> coordinate(-20.0f, 20.0f);
+  // Coordinates that are floats already, so that the file's float32 x y z hold them exactly.
+  auto next = [&] { return static_cast<double>(coordinate(random)); };
   std::vector<std::vector<double>> points;
   for (int i = 0; i < n; ++i) {
-    points.push_back({coordinate(random), coordinate(random), coordinate(random), 0.5, -0.5, 1.0,
-                      static_cast<double>(i * 7 % 65536), 0, static_cast<double>(i % 16),
-                      static_cast<double>(i) * 1000.0});
+    points.push_back({next(), next(), next(), 0.5, -0.5, 1.0, static_cast<double>(i * 7 % 65536), 0,
+                      static_cast<double>(i % 16), static_cast<double>(i) * 1000.0});
   }
   return points;
 }
@@ -187,7 +189,8 @@ TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
       for (int c = 0; c < 6; ++c) {
         const double e = elevations_deg[row] * M_PI / 180.0, a = -2.0 * M_PI * c / 6;
         if (row == 1 && c == 2) {
-          cells.push_back({NAN, NAN, NAN, 0});
+          const double nan = std::numeric_limits<double>::quiet_NaN();
+          cells.push_back({nan, nan, nan, 0});
           continue;
         }
         cells.push_back({10 * std::cos(e) * std::cos(a), 10 * std::cos(e) * std::sin(a),
@@ -222,6 +225,50 @@ TEST(PcdReader, OrganizedCloudMapsCellByCellAndFlipsBottomFirstRows) {
   }
 }
 
+/// An organized cloud of `beams` rows x 8 columns on `sensor`'s beams, rows listed in
+/// `rows_with_points` only.
+DecodedCloud organized_on(const config::SensorModel& sensor, const std::vector<int>& rows) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<double>> cells;
+  for (int r = 0; r < sensor.beams; ++r) {
+    const bool used = std::find(rows.begin(), rows.end(), r) != rows.end();
+    for (int c = 0; c < 8; ++c) {
+      const double e = sensor.elevation_rad[static_cast<size_t>(r)], a = -2 * M_PI * c / 8;
+      cells.push_back(used ? std::vector<double>{10 * std::cos(e) * std::cos(a),
+                                                 10 * std::cos(e) * std::sin(a), 10 * std::sin(e)}
+                           : std::vector<double>{nan, nan, nan});
+    }
+  }
+  return decode_pcd(test_pcd({{"x", 'F', 4}, {"y", 'F', 4}, {"z", 'F', 4}}, cells, Mode::kBinary, 8,
+                             sensor.beams),
+                    "organized.pcd");
+}
+
+TEST(PcdReader, OrganizedCloudSensorFromItsRows) {
+  const config::SensorModel os1_64 = config::sensor_preset("os1-64");
+  std::vector<int> all(64);
+  std::iota(all.begin(), all.end(), 0);
+  std::string why;
+  // Rows on the OS1-64's beams: that preset, not the HDL-64 that 64 rows alone suggest.
+  EXPECT_EQ(choose_sensor(organized_on(os1_64, all), SourceOptions{}, "o", &why).name, "os1-64")
+      << why;
+  // Rows on no preset's beams: elevations measured.
+  config::SensorModel odd = os1_64;
+  for (double& e : odd.elevation_rad) e *= 0.8;
+  const config::SensorModel measured = choose_sensor(organized_on(odd, all), SourceOptions{}, "o");
+  EXPECT_EQ(measured.beams, 64);
+  EXPECT_EQ(measured.columns, 8);
+  for (size_t r = 0; r < 64; ++r)
+    EXPECT_NEAR(measured.elevation_rad[r], odd.elevation_rad[r], 1e-6);
+  // Too few rows with points to measure: the preset with that many beams.
+  EXPECT_EQ(choose_sensor(organized_on(odd, {3, 40}), SourceOptions{}, "o", &why).name, "hdl64")
+      << why;
+  // A preset given that does not have one beam per row.
+  SourceOptions options;
+  options.sensor_preset = "vlp16";
+  EXPECT_THROW(choose_sensor(organized_on(os1_64, all), options, "o"), InputError);
+}
+
 TEST(PcdReader, OlderHeaderWithoutVersion) {
   std::string text =
       test_pcd({{"x", 'F', 4}, {"y", 'F', 4}, {"z", 'F', 4}}, {{1, 2, 3}}, Mode::kAscii);
@@ -244,7 +291,7 @@ std::vector<double> row_elevations_deg(const Scan& scan) {
       e.push_back(std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / M_PI);
     }
     if (e.empty()) {
-      out.push_back(NAN);
+      out.push_back(std::numeric_limits<double>::quiet_NaN());
       continue;
     }
     std::nth_element(e.begin(), e.begin() + static_cast<long>(e.size() / 2), e.end());

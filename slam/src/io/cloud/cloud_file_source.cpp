@@ -30,10 +30,9 @@ class CloudFileSource final : public ScanSource {
     scan_ = cloud_to_scan(decoded, info_.sensor, path, &stats, &warnings);
     info_.detail = cloud::describe(stats, &warnings, path) + "; sensor " + why;
     for (const std::string& w : warnings) warn(w);
-    // The stamp the file itself states wins; else one in its name; else 0.
-    if (!decoded.stamp_ns) {
-      scan_->stamp_ns = cloud::stamp_from_name(fs::path(path).stem().string()).value_or(0);
-    }
+    // As in folders: a stamp in the name, else the one the file states, else 0.
+    scan_->stamp_ns = cloud::stamp_from_name(fs::path(path).stem().string())
+                          .value_or(decoded.stamp_ns.value_or(0));
   }
 
   std::optional<Scan> next() override {

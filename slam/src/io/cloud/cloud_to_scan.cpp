@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "featsense/slam/io/cloud_files.hpp"
@@ -117,6 +118,42 @@ Scan organized_to_scan(const DecodedCloud& decoded, const std::string& origin,
   return scan;
 }
 
+/// An organized cloud's sensor, from its rows: the preset whose beams the rows lie on; else
+/// beam elevations measured from the rows when at least half of them hold points; else the
+/// preset with that many beams; else a model from the few rows measured.
+config::SensorModel sensor_of_rows(const DecodedCloud& decoded, const SourceOptions& options,
+                                   const std::string& origin,
+                                   const std::function<void(const std::string&)>& say) {
+  auto rows = cloud::row_elevations(decoded.cloud, decoded.width, decoded.height);
+  // cloud_to_scan() flips such files; the model describes the flipped rows.
+  if (cloud::lowest_row_first(rows)) std::reverse(rows.begin(), rows.end());
+  const std::string shape = std::to_string(decoded.height) + " rows";
+  if (const auto name = cloud::preset_fitting_rows(rows)) {
+    say("preset " + *name + " (the " + shape + " lie on its beams)");
+    return sensor_for(options, *name);
+  }
+  const auto measured = cloud::sensor_from_rows(rows, decoded.width);
+  const size_t rows_with_points = static_cast<size_t>(
+      std::count_if(rows.begin(), rows.end(), [](const auto& e) { return e.has_value(); }));
+  if (measured && 2 * rows_with_points >= rows.size()) {
+    say("beam elevations measured from the " + shape);
+    return *measured;
+  }
+  if (const auto name = cloud::preset_with_beams(decoded.height)) {
+    say("preset " + *name + " (" + shape + ", too few of them with points to measure)");
+    return sensor_for(options, *name);
+  }
+  if (measured) {
+    say("beam elevations measured from the " + std::to_string(rows_with_points) + " of " + shape +
+        " with points");
+    return *measured;
+  }
+  throw InputError(origin + ": an organized cloud of " + std::to_string(decoded.height) + " x " +
+                   std::to_string(decoded.width) +
+                   " whose sensor cannot be told; set --set sensor.preset=NAME (presets: " +
+                   preset_list() + ")");
+}
+
 }  // namespace
 
 config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptions& options,
@@ -135,22 +172,8 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
                          std::to_string(sensor.beams) + " beams");
       }
       say("preset " + sensor.name + " (sensor.preset)");
-    } else if (const auto name = cloud::preset_with_beams(decoded.height)) {
-      sensor = sensor_for(options, *name);
-      say("preset " + *name + " (" + std::to_string(decoded.height) + " rows)");
     } else {
-      auto rows = cloud::row_elevations(decoded.cloud, decoded.width, decoded.height);
-      // cloud_to_scan() flips such files; the model describes the flipped rows.
-      if (cloud::lowest_row_first(rows)) std::reverse(rows.begin(), rows.end());
-      const auto measured = cloud::sensor_from_rows(rows, decoded.width);
-      if (!measured) {
-        throw InputError(origin + ": an organized cloud of " + std::to_string(decoded.height) +
-                         " x " + std::to_string(decoded.width) +
-                         " whose sensor cannot be told; set --set sensor.preset=NAME (presets: " +
-                         preset_list() + ")");
-      }
-      sensor = *measured;
-      say("beam elevations measured from the " + std::to_string(decoded.height) + " rows");
+      sensor = sensor_of_rows(decoded, options, origin, say);
     }
     sensor.columns = decoded.width;
     return sensor;

@@ -63,6 +63,19 @@ std::optional<std::string> preset_with_beams(int beams) {
   return std::nullopt;
 }
 
+std::optional<std::string> preset_fitting_rows(const std::vector<std::optional<double>>& rows) {
+  for (const config::SensorModel& preset : builtin_presets()) {
+    if (static_cast<size_t>(preset.beams) != rows.size()) continue;
+    const double tolerance = 0.25 * smallest_spacing(preset.elevation_rad);
+    bool fits = true;
+    for (size_t r = 0; r < rows.size() && fits; ++r) {
+      fits = !rows[r] || std::abs(*rows[r] - preset.elevation_rad[r]) <= tolerance;
+    }
+    if (fits) return preset.name;
+  }
+  return std::nullopt;
+}
+
 std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
   std::vector<double> elevations;
   size_t data_points = 0;

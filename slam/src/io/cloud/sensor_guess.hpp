@@ -21,6 +21,10 @@ std::optional<std::string> preset_for_rings(int rings);
 /// The preset with exactly `beams` beams among those four, or nullopt.
 std::optional<std::string> preset_with_beams(int beams);
 
+/// The preset with one beam per row whose elevations every measured row (row 0 highest)
+/// matches within a quarter of its smallest beam spacing, or nullopt.
+std::optional<std::string> preset_fitting_rows(const std::vector<std::optional<double>>& rows);
+
 /// The preset on whose beam elevations at least 90 % of the cloud's points lie (within a
 /// quarter of its smallest beam spacing), with points on at least half of its beams; nullopt
 /// when no preset or more than one fits that well. Real sensors with per-unit calibrations

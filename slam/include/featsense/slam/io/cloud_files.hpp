@@ -46,8 +46,9 @@ DecodedCloud decode_kitti_bin(std::string_view bytes, const std::string& origin)
 /// The sensor model for a decoded cloud (`why` says how it was chosen):
 /// - options.sensor_preset when it is not "auto" (an organized cloud's height must equal its
 ///   beams);
-/// - organized clouds: the preset with `height` beams, else a model measured from the rows'
-///   elevations; columns = width either way;
+/// - organized clouds: the preset whose beams the rows lie on, else beam elevations measured
+///   from the rows (at least half of them with points), else the preset with `height` beams;
+///   columns = width either way;
 /// - a ring field: the smallest of vlp16 / hdl32 / hdl64 / os1-128 with beams > the largest
 ///   ring;
 /// - else the preset on whose beam elevations nearly all points lie (exact for simulated or
