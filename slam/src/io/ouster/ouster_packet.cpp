@@ -126,20 +126,6 @@ void decode_pixels(const uint8_t* first, size_t stride, int count, OusterPixel* 
 
 }  // namespace
 
-OusterPixel OusterPacketView::pixel(int column, int pixel) const {
-  const uint8_t* p = column_start(column) + layout_->column_header_bytes +
-                     static_cast<size_t>(pixel) * layout_->pixel_bytes;
-  switch (layout_->profile) {
-    case OusterProfile::kLegacy:
-      return legacy_pixel(p);
-    case OusterProfile::kRng19Rfl8Sig16Nir16:
-      return rng19_pixel(p);
-    case OusterProfile::kRng15Rfl8Nir8:
-      return rng15_pixel(p);
-  }
-  return {};
-}
-
 void OusterPacketView::column_pixels(int column, OusterPixel* out) const {
   const uint8_t* first = column_start(column) + layout_->column_header_bytes;
   const size_t stride = layout_->pixel_bytes;

@@ -44,13 +44,13 @@ struct OusterColumnHeader {
 /// inside the packet for any column index < layout.columns and pixel index < layout.pixels.
 class OusterPacketView {
  public:
-  /// nullptr-free view; `size` must equal layout.packet_bytes (checked: returns false).
+  /// Points the view at a packet; false (view unchanged) unless `data` is set and `size`
+  /// equals layout.packet_bytes.
   bool reset(const OusterPacketLayout& layout, const uint8_t* data, size_t size);
 
   /// The packet's frame id (legacy: that of its first valid column).
   uint16_t frame_id() const;
   OusterColumnHeader column(int column) const;
-  OusterPixel pixel(int column, int pixel) const;
   /// All layout.pixels pixels of a column into `out` (one profile dispatch per column).
   void column_pixels(int column, OusterPixel* out) const;
 

@@ -10,7 +10,10 @@
 namespace featsense::slam {
 
 /// An Ouster pcap; the metadata JSON is options.meta_path, else the .json in the same folder
-/// whose name shares the longest prefix with the pcap's.
+/// whose name shares the longest prefix with the pcap's. Lidar packets are the UDP payloads of
+/// the size the metadata implies, on any port. A capture that yields no frame at all (no such
+/// packet, or cut before the first) throws InputError from next(), naming the sizes it saw; a
+/// capture cut later ends with a counted warning after the frames before the cut.
 std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path, const SourceOptions& options);
 /// A ROS1 bag (format 2.0): sensor_msgs/PointCloud2 or raw ouster_ros/PacketMsg topics.
 std::unique_ptr<ScanSource> open_rosbag(const std::string& path, const SourceOptions& options);
