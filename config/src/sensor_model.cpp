@@ -60,8 +60,8 @@ void SensorModel::validate() const {
   if (columns < 1 || columns > 100000) throw ConfigError(who + "columns must be 1 .. 100000");
   if (!(rate_hz > 0.0 && rate_hz <= 100.0)) throw ConfigError(who + "rate_hz must be in (0, 100]");
   if (static_cast<int>(elevation_rad.size()) != beams) {
-    throw ConfigError(who + "needs one elevation per beam (" + std::to_string(beams) +
-                      "), has " + std::to_string(elevation_rad.size()));
+    throw ConfigError(who + "needs one elevation per beam (" + std::to_string(beams) + "), has " +
+                      std::to_string(elevation_rad.size()));
   }
   if (static_cast<int>(azimuth_offset_rad.size()) != beams) {
     throw ConfigError(who + "needs one azimuth offset per beam");

@@ -9,10 +9,10 @@
 namespace featsense::config {
 
 struct SensorModel {
-  std::string name;                     ///< preset name or product line, e.g. "os1-128"
-  int beams = 0;                        ///< rows of the range image
-  int columns = 0;                      ///< columns per revolution
-  double rate_hz = 10.0;                ///< revolutions per second
+  std::string name;       ///< preset name or product line, e.g. "os1-128"
+  int beams = 0;          ///< rows of the range image
+  int columns = 0;        ///< columns per revolution
+  double rate_hz = 10.0;  ///< revolutions per second
   /// Elevation of each beam above the horizontal plane, radians, row 0 = highest beam.
   std::vector<double> elevation_rad;
   /// Horizontal offset of each beam from its column's azimuth, radians (0 where none).

@@ -18,7 +18,7 @@ struct PointCloud {
   /// Per point, metres, where the format stores the sensor's own range; else empty and
   /// organize() uses |xyz|.
   std::vector<float> range_m;
-  std::vector<ScanChannel> channels; ///< per point, same names as in Scan
+  std::vector<ScanChannel> channels;  ///< per point, same names as in Scan
   int64_t stamp_ns = 0;
 
   size_t size() const { return xyz.size(); }

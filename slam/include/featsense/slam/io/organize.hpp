@@ -9,9 +9,9 @@ namespace featsense::slam {
 
 struct OrganizeStats {
   size_t input_points = 0;
-  size_t dropped_invalid = 0;    ///< zero, NaN or infinite points
-  size_t dropped_outside = 0;    ///< ring or elevation outside the sensor's beams
-  size_t dropped_collisions = 0; ///< a second point for an occupied cell (the nearer is kept)
+  size_t dropped_invalid = 0;     ///< zero, NaN or infinite points
+  size_t dropped_outside = 0;     ///< ring or elevation outside the sensor's beams
+  size_t dropped_collisions = 0;  ///< a second point for an occupied cell (the nearer is kept)
 };
 
 /// Places each point in the cell of its beam (the ring field where the cloud has one,
