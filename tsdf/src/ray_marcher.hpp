@@ -64,15 +64,20 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
   const bool interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
   if (interpolate) across = (1.0f / across_length) * across;
 
-  // Amanatides & Woo traversal, starting in the voxel where the clipped ray begins.
+  // Amanatides & Woo traversal from the far end back to the sensor. Every ray passes the
+  // few voxels next to the sensor; walking towards them, rays arrive there at different
+  // times and mostly find them already carved, instead of all contending for them at once.
   const float vs = map.voxel_size_m;
-  Index3 voxel = map.voxel_of(origin + t0 * dir);
+  const Vec3 walk_start = origin + t1 * dir;
+  const Vec3 walk_dir = -1.0f * dir;
+  const float walk_length = t1 - t0;
+  Index3 voxel = map.voxel_of(walk_start);
   int32_t step[3];
   float t_next[3];
   float t_delta[3];
   for (int axis = 0; axis < 3; ++axis) {
-    const float d = component(dir, axis);
-    const float o = component(origin, axis);
+    const float d = component(walk_dir, axis);
+    const float o = component(walk_start, axis);
     const int32_t v = component(voxel, axis);
     if (d > 0.0f) {
       step[axis] = 1;
@@ -98,10 +103,10 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
   const int32_t bricks[3] = {nb.x, nb.y, nb.z};
 
   const float tau = params.truncation_m;
-  float t = t0;
+  float t = 0.0f;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  for (int32_t i = 0; i < max_steps && t <= t1; ++i) {
+  for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
     if (map.contains(voxel)) {
       const Vec3 centre = map.centre_of(voxel);
       const float along = dot(centre - origin, dir);
