@@ -13,7 +13,7 @@ namespace {
 
 using test::Box;
 
-struct Setup {
+struct BoxScene {
   Box box;
   TriangleMesh mesh = test::box_mesh(box);
   RayCaster caster{mesh};
@@ -26,7 +26,7 @@ Eigen::Vector3d beam_origin(const config::SensorModel& s, int col) {
 }
 
 TEST(SimBoxRoom, NoiseOffEveryReturnLiesOnAWall) {
-  Setup setup;
+  BoxScene setup;
   const auto trajectory =
       make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
   SimulationSettings settings;
@@ -56,12 +56,13 @@ TEST(SimBoxRoom, NoiseOffEveryReturnLiesOnAWall) {
 }
 
 TEST(SimBoxRoom, NoisyReturnsStayWithinTheNoiseBound) {
-  Setup setup;
+  BoxScene setup;
   const auto trajectory =
       make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
   SimulationSettings settings;
   settings.sensor = test::small_sensor();
   settings.measurement.seed = 7;
+  settings.measurement.mixed_pixels = false;  // points between surfaces: tested below
   const LidarSimulator sim(setup.mesh, setup.caster, *trajectory, settings);
   const SimulatedFrame frame = sim.simulate(1);
   double worst = 0.0;
@@ -86,7 +87,7 @@ TEST(SimBoxRoom, NoisyReturnsStayWithinTheNoiseBound) {
 }
 
 TEST(SimBoxRoom, BeamElevationsRecoveredFromThePointsMatchTheSensorModel) {
-  Setup setup;
+  BoxScene setup;
   // Standing still (a very slow path) so that each column's pose is the same.
   const auto trajectory =
       make_spline_trajectory({Eigen::Vector3d(0, 0, 1.5), Eigen::Vector3d(1e-3, 0, 1.5)}, 1e-4);
@@ -110,7 +111,7 @@ TEST(SimBoxRoom, BeamElevationsRecoveredFromThePointsMatchTheSensorModel) {
 }
 
 TEST(SimBoxRoom, MotionDistortsTheScanAndGroundTruthUndistortsIt) {
-  Setup setup;
+  BoxScene setup;
   // A fast, turning, tilting path: 3 m/s with roll and pitch.
   const auto trajectory = make_spline_trajectory(
       {Eigen::Vector3d(-3, -2, 1.0), Eigen::Vector3d(0, 1, 2.0), Eigen::Vector3d(3, -1, 1.2)}, 3.0,
@@ -137,8 +138,56 @@ TEST(SimBoxRoom, MotionDistortsTheScanAndGroundTruthUndistortsIt) {
   EXPECT_GT(with_frame_pose, 0.1);  // 0.3 m of travel and a turn within the revolution
 }
 
+/// Distance from a point outside an axis-aligned box to the box (0 inside).
+double distance_outside(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                        const Eigen::Vector3d& hi) {
+  return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
+}
+
+TEST(SimBoxRoom, MixedPixelsLieBetweenAnEdgeAndTheSurfaceBehindIt) {
+  // The room with a pillar: its vertical edges are depth discontinuities, nothing else is.
+  const Box box;
+  TriangleMesh mesh = test::box_mesh(box);
+  const Eigen::Vector3d pillar_lo(2.0, -0.5, 0.0);
+  const Eigen::Vector3d pillar_hi(2.6, 0.1, 3.0);
+  mesh.add_box(pillar_lo.cast<float>(), pillar_hi.cast<float>(), 0);
+  const RayCaster caster(mesh);
+  const auto trajectory =
+      make_spline_trajectory({Eigen::Vector3d(-1, 0, 1.5), Eigen::Vector3d(-1, 1e-3, 1.5)}, 1e-4);
+  SimulationSettings settings;
+  settings.sensor = test::small_sensor();
+  settings.measurement = MeasurementSettings::exact();
+  settings.measurement.mixed_pixels = true;
+  settings.measurement.mixed_probability = 1.0;
+  const LidarSimulator sim(mesh, caster, *trajectory, settings);
+  const SimulatedFrame frame = sim.simulate(0);
+  const Scan& scan = frame.scan;
+  const Eigen::Isometry3d pose = trajectory->pose(0.0);
+  size_t mixed = 0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      const size_t i = scan.index(row, col);
+      ASSERT_TRUE(scan.valid[i]);
+      const Eigen::Vector3d p = pose * scan.xyz[i].cast<double>();
+      const double off_surface =
+          std::min(test::distance_to_box(p, box), distance_outside(p, pillar_lo, pillar_hi));
+      if (off_surface < 1e-4) continue;
+      ++mixed;
+      // Beside the pillar's silhouette: a neighbouring column sees the wall behind.
+      double neighbour = 0.0;
+      for (int n : {col - 1, col + 1}) {
+        neighbour =
+            std::max<double>(neighbour, scan.range_m[scan.index(row, (n + scan.cols) % scan.cols)]);
+      }
+      EXPECT_GT(neighbour, scan.range_m[i]) << row << " " << col;
+    }
+  }
+  EXPECT_GT(mixed, 0u);
+  EXPECT_LT(mixed, 4u * static_cast<size_t>(scan.rows));  // two edges, one cell each side
+}
+
 TEST(SimBoxRoom, NothingBeyondMaxRangeOrInsideMinRange) {
-  Setup setup;
+  BoxScene setup;
   const auto trajectory =
       make_spline_trajectory({Eigen::Vector3d(-4.5, 0, 1.5), Eigen::Vector3d(-4, 0, 1.5)}, 1.0);
   SimulationSettings settings;

@@ -6,20 +6,23 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
+#include <algorithm>
 
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
 #include "sim_test_util.hpp"
-#include "test_data.hpp"
+#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {
 
 std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::string bytes(static_cast<size_t>(std::max<std::streamoff>(in.tellg(), 0)), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return bytes;
 }
 
 /// Two frames of the lab scene (noise, drop-outs and mixed pixels on) into `dir`.

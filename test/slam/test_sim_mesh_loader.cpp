@@ -8,7 +8,7 @@
 #include "featsense/slam/sim/mesh_loader.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
-#include "test_data.hpp"
+#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
-#include "test_data.hpp"
+#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {

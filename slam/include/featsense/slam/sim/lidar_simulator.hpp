@@ -51,6 +51,9 @@ class LidarSimulator {
   const RayCaster& caster_;
   const Trajectory& trajectory_;
   SimulationSettings settings_;
+  // Per cell (row-major), sensor frame: beam origins (m) and unit directions, computed once.
+  std::vector<Eigen::Vector3d> local_origin_;
+  std::vector<Eigen::Vector3d> local_direction_;
 };
 
 /// The sensor-frame direction of beam `row` in column `col` (unit vector) and the beam's

@@ -25,8 +25,9 @@ struct MeasurementSettings {
   double dark_reflectance = 0.05;      ///< below this, returns vanish with rising odds
   double reference_reflectance = 0.8;  ///< reaches the sensor's max range head-on
   /// Mixed pixels: where the range jumps between neighbouring columns by more than
-  /// mixed_min_jump_m, the foreground cell reports, with probability mixed_probability, a
-  /// range between the two surfaces.
+  /// mixed_min_jump_m onto another surface (a point more than half that off this cell's
+  /// plane), the foreground cell reports, with probability mixed_probability, a range
+  /// between the two surfaces.
   bool mixed_pixels = true;
   double mixed_min_jump_m = 0.3;
   double mixed_probability = 0.5;
