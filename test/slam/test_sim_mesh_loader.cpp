@@ -4,11 +4,11 @@
 
 #include <fstream>
 
+#include "common/test_data.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/sim/mesh_loader.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
-#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -58,6 +58,49 @@ TEST(SimMeshLoader, ObjWithUnitScaleAndUpAxis) {
   EXPECT_NEAR(hi.z(), 2.0f, 1e-6f);
   EXPECT_NEAR(hi.x(), 1.0f, 1e-6f);
   EXPECT_NEAR(std::max(std::abs(lo.y()), std::abs(hi.y())), 0.0f, 1e-6f);
+}
+
+/// A COLLADA document holding one triangle, with the given up axis and unit.
+std::string collada_triangle(const std::string& up_axis, double metres_per_unit,
+                             const std::string& positions) {
+  return R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="u" meter=")" +
+         std::to_string(metres_per_unit) + R"("/><up_axis>)" + up_axis + R"(</up_axis></asset>
+  <library_geometries><geometry id="g"><mesh>
+    <source id="p"><float_array id="pa" count="9">)" +
+         positions + R"(</float_array>
+      <technique_common><accessor source="#pa" count="3" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+    <triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node id="n">
+    <instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)";
+}
+
+TEST(SimMeshLoader, ColladaSaysItsUpAxisAndUnit) {
+  const auto dir = test::scratch_dir("sim_mesh_dae");
+  // The same triangle, 1 m along x and its apex 2 m up, in a Z-up file in centimetres and
+  // in a Y-up file in metres.
+  const std::string z_up =
+      write_file(dir, "z_up.dae", collada_triangle("Z_UP", 0.01, "0 0 0 100 0 0 0 0 200"));
+  const std::string y_up =
+      write_file(dir, "y_up.dae", collada_triangle("Y_UP", 1.0, "0 0 0 1 0 0 0 2 0"));
+  for (const std::string& path : {z_up, y_up}) {
+    const TriangleMesh mesh = load_mesh(path);
+    ASSERT_EQ(mesh.triangle_count(), 1u) << path;
+    Eigen::Vector3f lo, hi;
+    mesh.bounds(&lo, &hi);
+    EXPECT_LT(lo.norm(), 1e-5f) << path;
+    EXPECT_NEAR(hi.x(), 1.0f, 1e-5f) << path;
+    EXPECT_NEAR(hi.z(), 2.0f, 1e-5f) << path;
+    EXPECT_NEAR(hi.y(), 0.0f, 1e-5f) << path;
+  }
 }
 
 TEST(SimMeshLoader, WrittenGroundTruthMeshReadsBack) {
