@@ -8,12 +8,15 @@
 #include <chrono>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.hpp"
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/io/ouster_metadata.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/mesh_loader.hpp"
@@ -43,6 +46,18 @@ struct SimulateOptions {
   bool no_mixed_pixels = false;
   int threads = 0;  ///< 0: all cores
 };
+
+/// A preset by name, or the sensor of an Ouster metadata JSON file (per-beam angles, beam
+/// origin offset, columns and rate of that unit).
+config::SensorModel sensor_model(const std::string& name_or_file) {
+  if (std::filesystem::path(name_or_file).extension() != ".json")
+    return config::sensor_preset(name_or_file);
+  std::ifstream in(name_or_file, std::ios::binary);
+  if (!in) throw slam::InputError(name_or_file + ": cannot read the sensor metadata");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return slam::parse_ouster_metadata(text.str(), name_or_file).sensor_model();
+}
 
 double thread_cpu_ms() {
   timespec t{};
@@ -80,7 +95,7 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   const std::unique_ptr<slam::Trajectory> trajectory = make_trajectory(o, builtin);
 
   slam::SimulationSettings settings;
-  settings.sensor = config::sensor_preset(o.sensor);
+  settings.sensor = sensor_model(o.sensor);
   if (o.rate_hz > 0.0) settings.sensor.rate_hz = o.rate_hz;
   settings.measurement.seed = o.seed;
   settings.measurement.range_noise = !o.no_noise;
@@ -147,7 +162,8 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
                    "DAE, STL)")
       ->required();
   command->add_option("-o,--output", o->output_dir, "Folder for the recording")->required();
-  command->add_option("--sensor", o->sensor, "Sensor preset")->capture_default_str();
+  command->add_option("--sensor", o->sensor, "Sensor preset, or an Ouster metadata .json")
+      ->capture_default_str();
   command->add_option("--path", o->path, "Named path of a built-in scene: walk, drive, drone");
   command->add_option("--trajectory", o->trajectory_file,
                       "TUM file of sensor poses (map <- sensor)");

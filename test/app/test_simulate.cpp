@@ -41,6 +41,21 @@ TEST(CliSimulate, LabFramesReadBackWithInfo) {
   EXPECT_GT(j["valid_points"]["min"].get<int>(), 128 * 1024 / 2);  // a closed room
 }
 
+TEST(CliSimulate, SensorFromOusterMetadata) {
+  FEATSENSE_SHARED_FILE(meta, "ouster/OS-1-128_v2.3.0_1024x10.json");
+  const auto dir = scratch_dir("cli_simulate_meta");
+  const std::string out = (dir / "corridor").string();
+  const CommandResult sim = run_featsense("simulate --quiet --scene corridor --frames 1 --sensor " +
+                                          meta.string() + " -o " + out);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const CommandResult info = run_featsense("info --quiet --json - " + out);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json j = nlohmann::json::parse(info.output);
+  EXPECT_EQ(j["frames"], 1);
+  EXPECT_EQ(j["rows"], 128);  // the unit's metadata: OS-1-128, 1024x10
+  EXPECT_EQ(j["cols"], 1024);
+}
+
 void expect_error(const std::string& args, const std::string& fragment) {
   const CommandResult r = run_featsense("simulate --quiet " + args);
   EXPECT_NE(r.exit_code, 0) << args;
