@@ -267,8 +267,10 @@ NamedPath scene_path(const std::string& scene, const std::string& path) {
                                   1.7);
       out.speed_mps = 1.4;
     } else if (path == "drive") {
-      out.waypoints_m =
-          at_height({P(-7.5, -7.5), P(0, -7.5), P(7, -6), P(7.5, 0), P(14, 0), P(27, 0)}, 0.5);
+      // Round the room, then straight through the east door into the corridor.
+      out.waypoints_m = at_height(
+          {P(-7.5, -7.5), P(0, -7.5), P(6, -6), P(7, -2), P(8.5, 0), P(10, 0), P(12, 0), P(27, 0)},
+          0.5);
       out.speed_mps = 1.2;
     } else if (path == "drone") {
       out.waypoints_m = {W(-7, -7, 1.5), W(0, -6, 3), W(6, -7, 2), W(7, 0, 3.2),  W(6, 7, 1.5),

@@ -251,7 +251,7 @@ void write_tum(const std::vector<StampedPose>& poses, const std::string& path) {
   for (const StampedPose& p : poses) {
     const Eigen::Quaterniond q(p.T_map_sensor.rotation());
     const Eigen::Vector3d& t = p.T_map_sensor.translation();
-    std::snprintf(line, sizeof line, "%.9f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", p.t_s,
+    std::snprintf(line, sizeof line, "%.6f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", p.t_s,
                   t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     out << line;
   }

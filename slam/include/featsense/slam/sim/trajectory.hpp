@@ -44,8 +44,8 @@ std::unique_ptr<Trajectory> make_sampled_trajectory(const std::vector<StampedPos
 /// naming the file and line for a malformed line, a non-unit quaternion or a time that
 /// does not increase.
 std::vector<StampedPose> read_tum(const std::string& path);
-/// Writes poses as TUM lines (9 decimals for time, full precision for the pose). Throws
-/// WriteError naming the path.
+/// Writes poses as TUM lines (time to the microsecond, which a double holds for Unix times;
+/// the pose at full precision). Throws WriteError naming the path.
 void write_tum(const std::vector<StampedPose>& poses, const std::string& path);
 
 }  // namespace featsense::slam
