@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "common/run_command.hpp"
@@ -54,6 +55,30 @@ TEST(CliSimulate, SensorFromOusterMetadata) {
   EXPECT_EQ(j["frames"], 1);
   EXPECT_EQ(j["rows"], 128);  // the unit's metadata: OS-1-128, 1024x10
   EXPECT_EQ(j["cols"], 1024);
+}
+
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+TEST(CliSimulate, SameSeedSameFilesOtherSeedOtherNoise) {
+  const auto dir = scratch_dir("cli_simulate_seed");
+  for (const std::string run : {"a", "b", "c"}) {
+    const std::string seed = run == "c" ? "6" : "5";
+    const CommandResult r = run_featsense(
+        "simulate --quiet --scene parking --path drone --frames 1 "
+        "--seed " +
+        seed + " -o " + (dir / run).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const std::string a = file_bytes(dir / "a" / "frame_000000.pcd");
+  EXPECT_GT(a.size(), 128u * 1024u * 20u);
+  EXPECT_TRUE(a == file_bytes(dir / "b" / "frame_000000.pcd"));
+  EXPECT_FALSE(a == file_bytes(dir / "c" / "frame_000000.pcd"));
+  EXPECT_TRUE(file_bytes(dir / "a" / "gt_points.ply") == file_bytes(dir / "b" / "gt_points.ply"));
 }
 
 void expect_error(const std::string& args, const std::string& fragment) {
