@@ -4,15 +4,15 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <algorithm>
 
+#include "common/test_data.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
 #include "sim_test_util.hpp"
-#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {

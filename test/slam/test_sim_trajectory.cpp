@@ -5,9 +5,9 @@
 #include <cmath>
 #include <fstream>
 
+#include "common/test_data.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
-#include "common/test_data.hpp"
 
 namespace featsense::slam {
 namespace {

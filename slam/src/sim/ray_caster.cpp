@@ -1,10 +1,10 @@
 // The only file that speaks Embree.
 #include "featsense/slam/sim/ray_caster.hpp"
 
-#include <Eigen/Geometry>
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Geometry>
 
 #include <stdexcept>
 #include <string>
