@@ -1,5 +1,6 @@
 #include "featsense/slam/sim/simulation_writer.hpp"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -30,14 +31,20 @@ void put_floats(std::string& out, const Eigen::Vector3f& v) {
   out.append(reinterpret_cast<const char*>(v.data()), 3 * sizeof(float));
 }
 
-/// Voxel key: 21 bits per axis (+-1M voxels, +-20 km at 2 cm).
+/// Voxel key: 21 bits per axis (+-1M voxels, +-20 km at 2 cm), bit 63 set so no key is 0.
 uint64_t voxel_key(const Eigen::Vector3f& p, double voxel_size_m) {
   uint64_t key = 0;
   for (int k = 0; k < 3; ++k) {
     const int64_t v = static_cast<int64_t>(std::floor(p[k] / voxel_size_m)) + (1 << 20);
     key = (key << 21) | (static_cast<uint64_t>(v) & 0x1FFFFFu);
   }
-  return key;
+  return key | (1ull << 63);
+}
+
+uint64_t slot_hash(uint64_t key) {
+  key ^= key >> 33;
+  key *= 0xFF51AFD7ED558CCDull;
+  return key ^ (key >> 33);
 }
 
 /// True when `sensor` is a preset unchanged (the rate aside, which sequence.yaml states), so
@@ -103,7 +110,27 @@ void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d&
   pose.T_map_sensor = T_map_sensor;
   poses_.push_back(pose);
   for (const Eigen::Vector3f& p : frame.surface_points_m) {
-    if (voxels_.insert(voxel_key(p, voxel_size_m_)).second) points_.push_back(p);
+    if (insert_voxel(voxel_key(p, voxel_size_m_))) points_.push_back(p);
+  }
+}
+
+bool SimulationWriter::insert_voxel(uint64_t key) {
+  if (2 * (voxel_count_ + 1) > voxel_slots_.size()) {  // keep the load below one half
+    std::vector<uint64_t> old(std::max<size_t>(1 << 16, 2 * voxel_slots_.size()), 0);
+    old.swap(voxel_slots_);
+    voxel_count_ = 0;
+    for (uint64_t k : old) {
+      if (k != 0) insert_voxel(k);
+    }
+  }
+  const size_t mask = voxel_slots_.size() - 1;  // a power of two
+  for (size_t i = slot_hash(key) & mask;; i = (i + 1) & mask) {
+    if (voxel_slots_[i] == key) return false;
+    if (voxel_slots_[i] == 0) {
+      voxel_slots_[i] = key;
+      ++voxel_count_;
+      return true;
+    }
   }
 }
 

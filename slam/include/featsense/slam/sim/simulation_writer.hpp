@@ -11,7 +11,6 @@
 #include <Eigen/Geometry>
 
 #include <string>
-#include <unordered_set>
 #include <vector>
 
 #include "featsense/config/sensor_model.hpp"
@@ -34,13 +33,19 @@ class SimulationWriter {
   size_t ground_truth_points() const { return points_.size(); }
 
  private:
+  /// Inserts a voxel key; true when it was new.
+  bool insert_voxel(uint64_t key);
+
   std::string folder_;
   config::SensorModel sensor_;
   double voxel_size_m_;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
   std::vector<StampedPose> poses_;
-  std::unordered_set<uint64_t> voxels_;
+  /// Occupied voxel keys, open addressing with linear probing (0 = empty slot; keys are
+  /// never 0): a node-based set spent more time than the simulation itself.
+  std::vector<uint64_t> voxel_slots_;
+  size_t voxel_count_ = 0;
   std::vector<Eigen::Vector3f> points_;
 };
 
