@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -65,9 +66,15 @@ double thread_cpu_ms() {
   return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
 }
 
-std::unique_ptr<slam::Trajectory> make_trajectory(const SimulateOptions& o, bool builtin) {
-  if (!o.trajectory_file.empty())
-    return slam::make_sampled_trajectory(slam::read_tum(o.trajectory_file));
+/// The sensor's path; `start_stamp_ns` is set to the TUM file's first time, so that the
+/// frames and gt_trajectory.tum share the file's clock.
+std::unique_ptr<slam::Trajectory> make_trajectory(const SimulateOptions& o, bool builtin,
+                                                  int64_t* start_stamp_ns) {
+  if (!o.trajectory_file.empty()) {
+    const std::vector<slam::StampedPose> poses = slam::read_tum(o.trajectory_file);
+    *start_stamp_ns = static_cast<int64_t>(std::llround(poses.front().t_s * 1e9));
+    return slam::make_sampled_trajectory(poses);
+  }
   if (!builtin)
     throw std::invalid_argument(
         "a scene mesh needs --trajectory FILE (named paths belong to "
@@ -92,9 +99,10 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   load.up_axis = o.up_axis;
   const slam::TriangleMesh mesh =
       builtin ? slam::build_scene(o.scene) : slam::load_mesh(o.scene, load);
-  const std::unique_ptr<slam::Trajectory> trajectory = make_trajectory(o, builtin);
-
   slam::SimulationSettings settings;
+  const std::unique_ptr<slam::Trajectory> trajectory =
+      make_trajectory(o, builtin, &settings.start_stamp_ns);
+
   settings.sensor = sensor_model(o.sensor);
   if (o.rate_hz > 0.0) settings.sensor.rate_hz = o.rate_hz;
   settings.measurement.seed = o.seed;
