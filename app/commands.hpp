@@ -20,6 +20,8 @@ struct Command {
 Command register_info(CLI::App& app, const CliContext& context);
 /// `featsense convert INPUT -o DIR`: one file per frame.
 Command register_convert(CLI::App& app, const CliContext& context);
+/// `featsense simulate --scene NAME|MESH -o DIR`: a simulated recording with ground truth.
+Command register_simulate(CLI::App& app, const CliContext& context);
 /// `featsense bench tsdf ...`: speed figures as JSON.
 Command register_bench(CLI::App& app, const CliContext& context);
 

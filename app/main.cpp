@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   context.add_options(app);
   const std::vector<featsense::app::Command> commands = {
       featsense::app::register_info(app, context), featsense::app::register_convert(app, context),
+      featsense::app::register_simulate(app, context),
       featsense::app::register_bench(app, context)};
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.

@@ -11,3 +11,6 @@ find_package(BZip2 REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+# The simulator: Embree casts the rays, assimp reads scene meshes (both only in slam/src/sim).
+find_package(embree 3 CONFIG REQUIRED)
+find_package(assimp CONFIG REQUIRED)

@@ -1,0 +1,51 @@
+#pragma once
+/// Sensor trajectories for the simulator: smooth splines through waypoints at constant
+/// speed, or the poses of a TUM file; and TUM reading and writing.
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace featsense::slam {
+
+/// A pose over time. Times are seconds from the trajectory's start; poses map sensor
+/// coordinates into the map (T_map_sensor), Z up.
+class Trajectory {
+ public:
+  virtual ~Trajectory() = default;
+  /// Seconds from the start to the last pose.
+  virtual double duration_s() const = 0;
+  /// T_map_sensor at `t_s` seconds after the start (clamped to [0, duration]).
+  virtual Eigen::Isometry3d pose(double t_s) const = 0;
+};
+
+/// One stamped pose of a TUM file: "t x y z qx qy qz qw", t in seconds.
+struct StampedPose {
+  double t_s = 0.0;
+  Eigen::Isometry3d T_map_sensor = Eigen::Isometry3d::Identity();
+};
+
+/// A C2 cubic spline (natural end conditions, chord-length knots) through `waypoints_m`
+/// (map frame, metres), travelled at `speed_mps` exactly (arc-length parameterised).
+/// Yaw follows the direction of travel; with `tilt` the sensor also rolls into turns (by
+/// the lateral acceleration against gravity) and pitches with climbs. Throws
+/// std::invalid_argument for fewer than two waypoints, repeated waypoints or speed <= 0.
+std::unique_ptr<Trajectory> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
+                                                   double speed_mps, bool tilt = false);
+
+/// Poses interpolated between samples (linear in position, slerp in rotation); times are
+/// taken relative to the first sample. Throws std::invalid_argument for fewer than two
+/// samples or times that do not increase.
+std::unique_ptr<Trajectory> make_sampled_trajectory(const std::vector<StampedPose>& poses);
+
+/// Reads a TUM trajectory; '#' comments and blank lines are skipped. Throws InputError
+/// naming the file and line for a malformed line, a non-unit quaternion or a time that
+/// does not increase.
+std::vector<StampedPose> read_tum(const std::string& path);
+/// Writes poses as TUM lines (time to the microsecond, which a double holds for Unix times;
+/// the pose at full precision). Throws WriteError naming the path.
+void write_tum(const std::vector<StampedPose>& poses, const std::string& path);
+
+}  // namespace featsense::slam

@@ -1,0 +1,111 @@
+// `featsense simulate` end to end: its folder reads back with `featsense info`, and bad input
+// gives one clear error.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "common/run_command.hpp"
+#include "common/test_data.hpp"
+
+namespace featsense::test {
+namespace {
+
+size_t count_lines(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) n += line.empty() ? 0 : 1;
+  return n;
+}
+
+TEST(CliSimulate, LabFramesReadBackWithInfo) {
+  const auto dir = scratch_dir("cli_simulate");
+  const std::string out = (dir / "lab").string();
+  const CommandResult sim = run_featsense("simulate --quiet --scene lab -o " + out + " --frames 3");
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  for (const char* name :
+       {"sequence.yaml", "frame_000002.pcd", "gt_trajectory.tum", "gt_mesh.ply", "gt_points.ply"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "lab" / name)) << name;
+  }
+  EXPECT_EQ(count_lines(dir / "lab" / "gt_trajectory.tum"), 3u);
+  const CommandResult info = run_featsense("info --quiet --json - " + out);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json j = nlohmann::json::parse(info.output);
+  EXPECT_EQ(j["format"], "simulated");
+  EXPECT_EQ(j["frames"], 3);
+  EXPECT_EQ(j["rows"], 128);  // the os1-128 preset
+  EXPECT_EQ(j["cols"], 1024);
+  EXPECT_GT(j["valid_points"]["min"].get<int>(), 128 * 1024 / 2);  // a closed room
+}
+
+TEST(CliSimulate, SensorFromOusterMetadata) {
+  FEATSENSE_SHARED_FILE(meta, "ouster/OS-1-128_v2.3.0_1024x10.json");
+  const auto dir = scratch_dir("cli_simulate_meta");
+  const std::string out = (dir / "corridor").string();
+  const CommandResult sim = run_featsense("simulate --quiet --scene corridor --frames 1 --sensor " +
+                                          meta.string() + " -o " + out);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const CommandResult info = run_featsense("info --quiet --json - " + out);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json j = nlohmann::json::parse(info.output);
+  EXPECT_EQ(j["frames"], 1);
+  EXPECT_EQ(j["rows"], 128);  // the unit's metadata: OS-1-128, 1024x10
+  EXPECT_EQ(j["cols"], 1024);
+}
+
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+TEST(CliSimulate, SameSeedSameFilesOtherSeedOtherNoise) {
+  const auto dir = scratch_dir("cli_simulate_seed");
+  for (const std::string run : {"a", "b", "c"}) {
+    const std::string seed = run == "c" ? "6" : "5";
+    const CommandResult r = run_featsense(
+        "simulate --quiet --scene parking --path drone --frames 1 "
+        "--seed " +
+        seed + " -o " + (dir / run).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const std::string a = file_bytes(dir / "a" / "frame_000000.pcd");
+  EXPECT_GT(a.size(), 128u * 1024u * 20u);
+  EXPECT_TRUE(a == file_bytes(dir / "b" / "frame_000000.pcd"));
+  EXPECT_FALSE(a == file_bytes(dir / "c" / "frame_000000.pcd"));
+  EXPECT_TRUE(file_bytes(dir / "a" / "gt_points.ply") == file_bytes(dir / "b" / "gt_points.ply"));
+}
+
+void expect_error(const std::string& args, const std::string& fragment) {
+  const CommandResult r = run_featsense("simulate --quiet " + args);
+  EXPECT_NE(r.exit_code, 0) << args;
+  EXPECT_NE(r.output.find("featsense: error:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(fragment), std::string::npos) << r.output;
+}
+
+TEST(CliSimulate, BadInputGivesClearErrors) {
+  const auto dir = scratch_dir("cli_simulate_bad");
+  const std::string out = " -o " + (dir / "out").string();
+  expect_error("--scene " + (dir / "missing.ply").string() + out + " --trajectory x.tum",
+               "missing.ply: no such mesh file");
+  std::ofstream(dir / "empty.ply") << "";
+  expect_error("--scene " + (dir / "empty.ply").string() + out + " --trajectory x.tum",
+               "empty.ply");
+  expect_error("--scene moon" + out, "no such mesh file");
+  expect_error("--scene lab --path fly" + out, "unknown path 'fly'");
+  std::ofstream(dir / "bad.tum") << "0 0 0 1.5 0 0 0 1\n0.5 1 0 1.5 0 0\n";
+  expect_error("--scene lab --trajectory " + (dir / "bad.tum").string() + out, "bad.tum:2:");
+  // From the room's centre out through the wall and beyond the scene.
+  std::ofstream(dir / "away.tum") << "0 0 0 1.5 0 0 0 1\n2 100 0 1.5 0 0 0 1\n";
+  expect_error("--scene lab --trajectory " + (dir / "away.tum").string() + out,
+               "the path leaves the scene at t = ");
+  expect_error("--scene lab --frames 100000" + out, "room for");
+}
+
+}  // namespace
+}  // namespace featsense::test

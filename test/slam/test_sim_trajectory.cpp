@@ -1,0 +1,150 @@
+// Splines through waypoints (C2, constant speed, yaw along travel), TUM files and their errors.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "common/test_data.hpp"
+#include "featsense/slam/scan_source.hpp"
+#include "featsense/slam/sim/trajectory.hpp"
+
+namespace featsense::slam {
+namespace {
+
+const std::vector<Eigen::Vector3d> kWaypoints = {
+    Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(5, 1, 1.5), Eigen::Vector3d(8, 6, 1),
+    Eigen::Vector3d(3, 9, 2), Eigen::Vector3d(-2, 7, 1)};
+constexpr double kSpeed = 1.5;
+
+Eigen::Vector3d position(const Trajectory& t, double s) { return t.pose(s).translation(); }
+
+/// The time at which the path passes closest to `p` (golden-section search around `guess`).
+double time_nearest(const Trajectory& t, const Eigen::Vector3d& p, double lo, double hi) {
+  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int k = 0; k < 200; ++k) {
+    const double a = hi - g * (hi - lo);
+    const double b = lo + g * (hi - lo);
+    if ((position(t, a) - p).norm() < (position(t, b) - p).norm())
+      hi = b;
+    else
+      lo = a;
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(SimTrajectory, SplinePassesThroughWaypointsAtConstantSpeed) {
+  const auto t = make_spline_trajectory(kWaypoints, kSpeed);
+  EXPECT_NEAR((position(*t, 0.0) - kWaypoints.front()).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((position(*t, t->duration_s()) - kWaypoints.back()).norm(), 0.0, 1e-9);
+  // The path is longer than the polyline through the waypoints.
+  double polyline = 0.0;
+  for (size_t i = 1; i < kWaypoints.size(); ++i)
+    polyline += (kWaypoints[i] - kWaypoints[i - 1]).norm();
+  EXPECT_GT(t->duration_s() * kSpeed, polyline);
+  const double h = 1e-4;
+  for (double s = 0.01; s < t->duration_s() - 0.01; s += 0.0731) {
+    const double speed = (position(*t, s + h) - position(*t, s - h)).norm() / (2.0 * h);
+    EXPECT_NEAR(speed, kSpeed, 1e-5) << "at t = " << s;
+  }
+  // Every interior waypoint lies on the path.
+  for (size_t i = 1; i + 1 < kWaypoints.size(); ++i) {
+    const double tw = time_nearest(*t, kWaypoints[i], 0.0, t->duration_s());
+    EXPECT_LT((position(*t, tw) - kWaypoints[i]).norm(), 1e-6) << "waypoint " << i;
+  }
+}
+
+TEST(SimTrajectory, AccelerationIsContinuousAtWaypoints) {
+  const auto t = make_spline_trajectory(kWaypoints, kSpeed);
+  const double h = 2e-3;
+  for (size_t i = 1; i + 1 < kWaypoints.size(); ++i) {
+    const double tw = time_nearest(*t, kWaypoints[i], 0.0, t->duration_s());
+    const Eigen::Vector3d p0 = position(*t, tw);
+    // One-sided second differences from each side of the waypoint.
+    const Eigen::Vector3d left =
+        (p0 - 2.0 * position(*t, tw - h) + position(*t, tw - 2.0 * h)) / (h * h);
+    const Eigen::Vector3d right =
+        (position(*t, tw + 2.0 * h) - 2.0 * position(*t, tw + h) + p0) / (h * h);
+    // A C1-only join would jump by the order of speed^2 / radius (~0.5 m/s^2 here); a C2
+    // one differs by the jerk times the stencil width only.
+    EXPECT_LT((left - right).norm(), 0.03) << "waypoint " << i;
+    EXPECT_GT(left.norm(), 0.01);  // the path does turn there
+  }
+}
+
+TEST(SimTrajectory, YawFollowsTheDirectionOfTravelAndTiltLeansIntoTurns) {
+  const auto flat = make_spline_trajectory(kWaypoints, kSpeed);
+  const auto tilted = make_spline_trajectory(kWaypoints, kSpeed, true);
+  for (double s = 0.5; s < flat->duration_s() - 0.5; s += 0.9) {
+    const Eigen::Vector3d v = position(*flat, s + 1e-4) - position(*flat, s - 1e-4);
+    const Eigen::Vector3d x_axis = flat->pose(s).rotation().col(0);
+    EXPECT_NEAR(std::atan2(x_axis.y(), x_axis.x()), std::atan2(v.y(), v.x()), 1e-4);
+    EXPECT_NEAR(flat->pose(s).rotation().col(2).z(), 1.0, 1e-12);  // upright
+    // The tilted sensor's forward axis follows the velocity, climbs included.
+    EXPECT_NEAR(tilted->pose(s).rotation().col(0).dot(v.normalized()), 1.0, 1e-6);
+  }
+  // Turning left (towards +y after the first waypoint): the sensor's up axis leans left.
+  const double tw = time_nearest(*tilted, kWaypoints[2], 0.0, tilted->duration_s());
+  const Eigen::Matrix3d r = tilted->pose(tw).rotation();
+  const Eigen::Vector3d left = r.col(1);
+  EXPECT_GT(r.col(2).dot(left - left.z() * Eigen::Vector3d::UnitZ()), 0.0);
+}
+
+TEST(SimTrajectory, BadSplinesAreRefused) {
+  EXPECT_THROW(make_spline_trajectory({Eigen::Vector3d::Zero()}, 1.0), std::invalid_argument);
+  EXPECT_THROW(make_spline_trajectory(kWaypoints, 0.0), std::invalid_argument);
+  EXPECT_THROW(make_spline_trajectory({Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}, 1.0),
+               std::invalid_argument);
+}
+
+TEST(SimTrajectory, TumRoundTripAndInterpolation) {
+  const auto dir = test::scratch_dir("sim_tum");
+  const auto spline = make_spline_trajectory(kWaypoints, kSpeed, true);
+  std::vector<StampedPose> poses;
+  for (int k = 0; k <= 20; ++k) {
+    StampedPose p;
+    p.t_s = 1700000000.0 + 0.5 * k;
+    p.T_map_sensor = spline->pose(0.5 * k);
+    poses.push_back(p);
+  }
+  const std::string path = (dir / "poses.tum").string();
+  write_tum(poses, path);
+  const std::vector<StampedPose> back = read_tum(path);
+  ASSERT_EQ(back.size(), poses.size());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_NEAR(back[i].t_s, poses[i].t_s, 1e-6);
+    EXPECT_TRUE(back[i].T_map_sensor.isApprox(poses[i].T_map_sensor, 1e-12));
+  }
+  const auto sampled = make_sampled_trajectory(back);
+  EXPECT_NEAR(sampled->duration_s(), 10.0, 1e-6);
+  // Half way between samples: the mean of the positions.
+  const Eigen::Vector3d mid =
+      0.5 * (poses[3].T_map_sensor.translation() + poses[4].T_map_sensor.translation());
+  EXPECT_LT((sampled->pose(1.75).translation() - mid).norm(), 1e-6);
+}
+
+void expect_tum_error(const std::string& text, const std::string& fragment) {
+  const auto dir = test::scratch_dir("sim_tum_bad");
+  const std::string path = (dir / "bad.tum").string();
+  std::ofstream(path) << text;
+  try {
+    read_tum(path);
+    ADD_FAILURE() << "no error for: " << text;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+TEST(SimTrajectory, BadTumLinesAreNamed) {
+  const std::string ok = "# t x y z qx qy qz qw\n0 0 0 0 0 0 0 1\n";
+  expect_tum_error(ok + "0.1 1 2 3\n", "bad.tum:3: expected 8 numbers");
+  expect_tum_error(ok + "0.1 1 2 3 0 0 0 1 9\n", "bad.tum:3: more than 8 values");
+  expect_tum_error(ok + "0.1 1 2 x 0 0 0 1\n", "bad.tum:3:");
+  expect_tum_error(ok + "0.1 1 2 3 0 0 0 2\n", "bad.tum:3: the quaternion is not a unit");
+  expect_tum_error(ok + "0 1 2 3 0 0 0 1\n", "bad.tum:3: time");
+  expect_tum_error(ok, "at least two poses");
+  EXPECT_THROW(read_tum("/nonexistent/poses.tum"), InputError);
+}
+
+}  // namespace
+}  // namespace featsense::slam
