@@ -11,3 +11,6 @@ find_package(BZip2 REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+# CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings
+# never fail our build. Only mesh/src/closest_point_query.cpp includes it.
+find_package(CGAL CONFIG REQUIRED)
