@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "eval_json.hpp"
+#include "featsense/config/config_error.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/viewer_export/ply_mesh_io.hpp"
 #include "json_output.hpp"
@@ -20,6 +21,8 @@ struct EvalTrajOptions {
   std::string align = "se3";
   double max_diff_s = 0.01;
   double offset_s = 0.0;
+  std::optional<std::string> estimate_times;
+  std::optional<std::string> ground_truth_times;
   std::optional<std::string> json_path;
   std::optional<std::string> aligned_path;
 };
@@ -39,9 +42,19 @@ void emit(const nlohmann::json& json, const std::optional<std::string>& path,
   if (path != "-") std::cout << text;
 }
 
+slam::Trajectory read_trajectory(const std::string& path, const std::string& format,
+                                 const std::optional<std::string>& times) {
+  if (times && format != "kitti") {
+    throw config::ConfigError("--est-times / --gt-times go with --format kitti");
+  }
+  return format == "kitti" ? slam::read_kitti(path, times) : slam::read_tum(path);
+}
+
 void run_traj(const EvalTrajOptions& options) {
-  const slam::Trajectory estimate = slam::read_trajectory(options.estimate, options.format);
-  const slam::Trajectory ground_truth = slam::read_trajectory(options.ground_truth, options.format);
+  const slam::Trajectory estimate =
+      read_trajectory(options.estimate, options.format, options.estimate_times);
+  const slam::Trajectory ground_truth =
+      read_trajectory(options.ground_truth, options.format, options.ground_truth_times);
   slam::TrajectoryEvaluationSettings settings;
   settings.alignment = slam::parse_alignment(options.align);
   settings.association.max_diff_s = options.max_diff_s;
@@ -155,6 +168,10 @@ std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/)
   traj->add_option("--t-offset", traj_options->offset_s,
                    "Added to the estimate's stamps before pairing (as evo's --t_offset), seconds")
       ->capture_default_str();
+  traj->add_option("--est-times", traj_options->estimate_times,
+                   "KITTI: the estimate's times file (seconds, one a line); else paired by index");
+  traj->add_option("--gt-times", traj_options->ground_truth_times,
+                   "KITTI: the ground truth's times file (seconds, one a line)");
   traj->add_option("--json", traj_options->json_path, "Write the figures as JSON ('-' = stdout)");
   traj->add_option("--aligned-out", traj_options->aligned_path,
                    "Write the paired, aligned estimate as TUM");

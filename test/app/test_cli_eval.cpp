@@ -60,6 +60,38 @@ TEST(CliEval, TrajReportsApeRpeAndPairsAsJson) {
   EXPECT_TRUE(std::filesystem::exists(dir / "aligned.tum"));
 }
 
+TEST(CliEval, TrajReadsKittiPairedByIndexOrByTimes) {
+  const auto dir = scratch_dir("cli_eval_kitti");
+  // Ground truth along x, 1 m a frame, 150 frames; the estimate runs 2 % long.
+  std::ofstream gt(dir / "gt.txt");
+  std::ofstream est(dir / "est.txt");
+  std::ofstream times(dir / "times.txt");
+  for (int i = 0; i < 150; ++i) {
+    gt << "1 0 0 " << i << " 0 1 0 0 0 0 1 0\n";
+    est << "1 0 0 " << 1.02 * i << " 0 1 0 0 0 0 1 0\n";
+    times << 0.1 * i << "\n";
+  }
+  gt.close();
+  est.close();
+  times.close();
+  const std::string files = (dir / "est.txt").string() + " " + (dir / "gt.txt").string();
+  const CommandResult r =
+      run_featsense("eval traj " + files + " --format kitti --align none --json -");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["pairs"], 150);
+  EXPECT_TRUE(j["association"]["by_index"].get<bool>());
+  EXPECT_NEAR(j["ape"]["max"].get<double>(), 0.02 * 149, 1e-6);
+  EXPECT_NEAR(j["rpe"]["mean"].get<double>(), 0.02, 1e-6);
+  // 100 m segments from frames 0..40 span 101 m: 2 % of 101 m over 100 m.
+  EXPECT_NEAR(j["kitti"]["t_err_pct"].get<double>(), 2.0 * 1.01, 1e-6);
+  const CommandResult timed =
+      run_featsense("eval traj " + files + " --format kitti --align none --json - --est-times " +
+                    (dir / "times.txt").string() + " --gt-times " + (dir / "times.txt").string());
+  ASSERT_EQ(timed.exit_code, 0) << timed.output;
+  EXPECT_FALSE(nlohmann::json::parse(timed.output)["association"]["by_index"].get<bool>());
+}
+
 TEST(CliEval, TrajErrorsAreClear) {
   const auto dir = scratch_dir("cli_eval_traj_errors");
   write_circle_tum(dir / "gt.tum", 50, 0.0, 0.0);
