@@ -15,6 +15,11 @@ void validate(const TriangleMesh& mesh, const std::string& what) {
       }
     }
   }
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (!mesh.vertices[v].allFinite()) {
+      throw MeshError(what + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.vertices.size()) {
     throw MeshError(what + ": " + std::to_string(mesh.normals.size()) + " normals for " +
                     std::to_string(mesh.vertices.size()) + " vertices");

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <limits>
 
 #include "featsense/mesh/compare_to_reference.hpp"
 #include "mesh_test_shapes.hpp"
@@ -164,6 +165,12 @@ TEST(MeshCompare, EmptyAndDegenerateInputsAreErrors) {
   flat.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
   flat.triangles = {{0, 1, 2}};
   EXPECT_NE(error_of([&] { mesh::compare_to_reference(plane, flat); }).find("degenerate"),
+            std::string::npos);
+  mesh::TriangleMesh nan_point = plane;
+  nan_point.vertices[3].y() = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(error_of([&] {
+              mesh::compare_to_reference(nan_point, plane);
+            }).find("the estimate: vertex 3 has a non-finite coordinate"),
             std::string::npos);
   mesh::TriangleMesh broken = plane;
   broken.triangles.emplace_back(0, 1, 99);

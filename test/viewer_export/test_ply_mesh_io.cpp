@@ -112,6 +112,12 @@ TEST(PlyMeshIo, ErrorsNameTheFile) {
                          "property list uchar int vertex_indices\nend_header\n0 0 0\n3 0 1 2\n";
   EXPECT_NE(error_of([&] { viewer_export::read_ply_mesh(path); }).find("refers to vertex 1"),
             std::string::npos);
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                         "property float y\nproperty float z\nelement face 1\n"
+                         "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"
+                         "0 1 0\n3 0 1 -2\n";
+  EXPECT_NE(error_of([&] { viewer_export::read_ply_mesh(path); }).find("vertex index out of range"),
+            std::string::npos);
   std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n";
   EXPECT_NE(error_of([&] { viewer_export::read_ply_mesh(path); }).find("no end_header"),
             std::string::npos);

@@ -1,6 +1,7 @@
 // PLY reader for meshes and point clouds: parses the header, then reads every element in
 // order, keeping the vertex positions, normals and faces.
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -173,7 +174,8 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path) {
         nxyz[k] = find(element, normal_names[k]);
         if (xyz[k] < 0) throw PlyError(path + ": vertex element has no '" + names[k] + "'");
       }
-      mesh.vertices.reserve(element.count);
+      // A header may claim more than the file holds: reserve no more than a plausible share.
+      mesh.vertices.reserve(std::min<size_t>(element.count, size_t{1} << 20));
     }
     if (is_face) {
       indices = find(element, "vertex_indices");
@@ -196,7 +198,11 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path) {
         if (count < 0 || count > 1e6) reader.fail("bad list length in element " + element.name);
         polygon.clear();
         for (auto k = static_cast<long long>(count); k > 0; --k) {
-          polygon.push_back(static_cast<long long>(reader.read(property.type)));
+          const double index = reader.read(property.type);
+          if (!(index >= 0 && index < 2147483647.0)) {
+            reader.fail("vertex index out of range in element " + element.name);
+          }
+          polygon.push_back(static_cast<long long>(index));
         }
         if (static_cast<int>(p) == indices) {
           for (size_t k = 2; k < polygon.size(); ++k) {

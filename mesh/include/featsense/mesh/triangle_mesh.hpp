@@ -24,7 +24,8 @@ struct TriangleMesh {
   bool has_normals() const { return !normals.empty() && normals.size() == vertices.size(); }
 };
 
-/// Throws MeshError when an index is out of range or normals do not match the vertices;
+/// Throws MeshError when a coordinate is not finite, an index is out of range or normals do not
+/// match the vertices;
 /// `what` names the mesh in the message.
 void validate(const TriangleMesh& mesh, const std::string& what);
 
