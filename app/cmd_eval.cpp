@@ -1,5 +1,8 @@
 // featsense eval traj | mesh: figures of a trajectory or mesh against ground truth.
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -65,6 +68,13 @@ void run_traj(const EvalTrajOptions& options) {
   nlohmann::json json = trajectory_evaluation_json(evaluation, settings);
   json["estimate"] = options.estimate;
   json["ground_truth"] = options.ground_truth;
+  json["estimate_poses"] = estimate.size();
+  json["ground_truth_poses"] = ground_truth.size();
+  // Few pairs usually mean a clock offset or a rate mismatch rather than a short overlap.
+  if (2 * evaluation.association.size() < std::min(estimate.size(), ground_truth.size())) {
+    spdlog::warn("only {} of {} poses paired: check --t-offset and --max-diff",
+                 evaluation.association.size(), std::min(estimate.size(), ground_truth.size()));
+  }
 
   char line[256];
   std::string text;

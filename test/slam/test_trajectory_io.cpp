@@ -93,5 +93,16 @@ TEST(TrajectoryIo, ErrorsNameFileAndLine) {
             std::string::npos);
 }
 
+TEST(TrajectoryIo, ReadsTheSharedKittiPoses) {
+  FEATSENSE_SHARED_FILE(path, "ouster/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt");
+  const slam::Trajectory t = slam::read_kitti(path.string());
+  ASSERT_EQ(t.size(), 3u);  // one pose per frame of the recording
+  EXPECT_FALSE(t.has_stamps);
+  // The sensor moves about 0.25 m per frame (../shared/data/README.md).
+  const double step = (t.poses[1].translation() - t.poses[0].translation()).norm();
+  EXPECT_GT(step, 0.1);
+  EXPECT_LT(step, 0.5);
+}
+
 }  // namespace
 }  // namespace featsense::test
