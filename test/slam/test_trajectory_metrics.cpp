@@ -185,6 +185,11 @@ TEST(TrajectoryMetrics, BadInputGivesClearErrors) {
   slam::TrajectoryEvaluationSettings none;
   none.alignment = Alignment::kNone;
   EXPECT_NO_THROW(slam::evaluate_trajectory(line, line, none));
+  const std::vector<Eigen::Vector3d> two = {{0, 0, 0}, {1, 2, 3}};
+  EXPECT_NE(error_of([&] { slam::umeyama(two, two, false); }).find("at least 3 pose pairs"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { slam::parse_alignment("sim3"); }).find("unknown alignment 'sim3'"),
+            std::string::npos);
 }
 
 // The KITTI devkit's metric on a 1000 m straight line (1 m per frame) whose estimate runs 1 %
