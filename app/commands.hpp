@@ -24,5 +24,7 @@ Command register_convert(CLI::App& app, const CliContext& context);
 Command register_simulate(CLI::App& app, const CliContext& context);
 /// `featsense bench tsdf ...`: speed figures as JSON.
 Command register_bench(CLI::App& app, const CliContext& context);
+/// `featsense eval traj|mesh ...`: figures against ground truth (one command per subcommand).
+std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
 
 }  // namespace featsense::app

@@ -43,10 +43,11 @@ int main(int argc, char** argv) {
   app.fallthrough();  // global options may also follow the subcommand
   featsense::app::CliContext context;
   context.add_options(app);
-  const std::vector<featsense::app::Command> commands = {
-      featsense::app::register_info(app, context), featsense::app::register_convert(app, context),
-      featsense::app::register_simulate(app, context),
-      featsense::app::register_bench(app, context)};
+  std::vector<featsense::app::Command> commands = {featsense::app::register_info(app, context),
+                                                   featsense::app::register_convert(app, context),
+                                                   featsense::app::register_simulate(app, context),
+                                                   featsense::app::register_bench(app, context)};
+  for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.
   for (const auto& command : commands) {

@@ -14,3 +14,6 @@ pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
 # The simulator: Embree casts the rays, assimp reads scene meshes (both only in slam/src/sim).
 find_package(embree 3 CONFIG REQUIRED)
 find_package(assimp CONFIG REQUIRED)
+# CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings
+# never fail our build. Only mesh/src/closest_point_query.cpp includes it.
+find_package(CGAL CONFIG REQUIRED)

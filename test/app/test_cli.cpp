@@ -19,7 +19,8 @@ TEST(Cli, VersionAndHelpOnEveryLevel) {
   const CommandResult version = run_featsense("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_NE(version.output.find("featsense "), std::string::npos);
-  for (const std::string level : {"", "info ", "convert ", "bench tsdf "}) {
+  for (const std::string level :
+       {"", "info ", "convert ", "bench tsdf ", "eval traj ", "eval mesh "}) {
     const CommandResult help = run_featsense(level + "--help");
     EXPECT_EQ(help.exit_code, 0) << level;
     EXPECT_NE(help.output.find("--quiet"), std::string::npos) << level << help.output;

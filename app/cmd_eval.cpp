@@ -1,0 +1,214 @@
+// featsense eval traj | mesh: figures of a trajectory or mesh against ground truth.
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "eval_json.hpp"
+#include "featsense/config/config_error.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/viewer_export/ply_mesh_io.hpp"
+#include "json_output.hpp"
+
+namespace featsense::app {
+namespace {
+
+struct EvalTrajOptions {
+  std::string estimate;
+  std::string ground_truth;
+  std::string format = "tum";
+  std::string align = "se3";
+  double max_diff_s = 0.01;
+  double offset_s = 0.0;
+  std::optional<std::string> estimate_times;
+  std::optional<std::string> ground_truth_times;
+  std::optional<std::string> json_path;
+  std::optional<std::string> aligned_path;
+};
+
+struct EvalMeshOptions {
+  std::string estimate;
+  std::string reference;
+  double max_dist_m = 0.0;
+  double samples_per_m2 = mesh::CompareSettings{}.samples_per_m2;
+  std::optional<std::string> json_path;
+  std::optional<std::string> ply_path;
+};
+
+void emit(const nlohmann::json& json, const std::optional<std::string>& path,
+          const std::string& text) {
+  if (path) write_json(json, *path);
+  if (path != "-") std::cout << text;
+}
+
+slam::Trajectory read_trajectory(const std::string& path, const std::string& format,
+                                 const std::optional<std::string>& times) {
+  if (times && format != "kitti") {
+    throw config::ConfigError("--est-times / --gt-times go with --format kitti");
+  }
+  return format == "kitti" ? slam::read_kitti(path, times) : slam::read_tum(path);
+}
+
+void run_traj(const EvalTrajOptions& options) {
+  const slam::Trajectory estimate =
+      read_trajectory(options.estimate, options.format, options.estimate_times);
+  const slam::Trajectory ground_truth =
+      read_trajectory(options.ground_truth, options.format, options.ground_truth_times);
+  slam::TrajectoryEvaluationSettings settings;
+  settings.alignment = slam::parse_alignment(options.align);
+  settings.association.max_diff_s = options.max_diff_s;
+  settings.association.offset_s = options.offset_s;
+  const slam::TrajectoryEvaluation evaluation =
+      slam::evaluate_trajectory(estimate, ground_truth, settings);
+  if (options.aligned_path) slam::write_tum(evaluation.aligned_estimate, *options.aligned_path);
+  nlohmann::json json = trajectory_evaluation_json(evaluation, settings);
+  json["estimate"] = options.estimate;
+  json["ground_truth"] = options.ground_truth;
+  json["estimate_poses"] = estimate.size();
+  json["ground_truth_poses"] = ground_truth.size();
+  // Few pairs usually mean a clock offset or a rate mismatch rather than a short overlap.
+  if (2 * evaluation.association.size() < std::min(estimate.size(), ground_truth.size())) {
+    spdlog::warn("only {} of {} poses paired: check --t-offset and --max-diff",
+                 evaluation.association.size(), std::min(estimate.size(), ground_truth.size()));
+  }
+
+  char line[256];
+  std::string text;
+  std::snprintf(line, sizeof line, "pairs:  %zu of %zu estimated and %zu ground-truth poses\n",
+                evaluation.association.size(), estimate.size(), ground_truth.size());
+  text += line;
+  const slam::ErrorStatistics& a = evaluation.ape;
+  std::snprintf(line, sizeof line,
+                "APE:    rmse %.4f m, mean %.4f, median %.4f, std %.4f, min %.4f, max %.4f\n",
+                a.rmse, a.mean, a.median, a.std, a.min, a.max);
+  text += line;
+  const slam::ErrorStatistics& r = evaluation.rpe_translation;
+  std::snprintf(line, sizeof line,
+                "RPE:    per frame rmse %.4f m, mean %.4f; rotation mean %.4f deg\n", r.rmse,
+                r.mean, evaluation.rpe_rotation_deg.mean);
+  text += line;
+  if (evaluation.kitti) {
+    std::snprintf(line, sizeof line, "KITTI:  %.3f %% translation, %.5f deg/m (%zu segments)\n",
+                  evaluation.kitti->t_err_pct, evaluation.kitti->r_err_deg_per_m,
+                  evaluation.kitti->segments);
+  } else {
+    std::snprintf(line, sizeof line, "KITTI:  path %.1f m, shorter than the 100 m segments\n",
+                  evaluation.ground_truth_length_m);
+  }
+  text += line;
+  emit(json, options.json_path, text);
+}
+
+mesh::TriangleMesh read_mesh(const std::string& path, const std::string& what) {
+  try {
+    return viewer_export::read_ply_mesh(path);
+  } catch (const viewer_export::PlyError& e) {
+    throw std::runtime_error(what + ": " + e.what());
+  }
+}
+
+void run_mesh(const EvalMeshOptions& options) {
+  const mesh::TriangleMesh estimate = read_mesh(options.estimate, "MESH");
+  const mesh::TriangleMesh reference = read_mesh(options.reference, "REFERENCE");
+  mesh::CompareSettings settings;
+  settings.max_dist_m = options.max_dist_m;
+  settings.samples_per_m2 = options.samples_per_m2;
+  mesh::CompareResult result;
+  try {
+    result = mesh::compare_to_reference(estimate, reference, settings);
+  } catch (const mesh::MeshError& e) {
+    throw std::runtime_error(options.estimate + " vs " + options.reference + ": " + e.what());
+  }
+  if (options.ply_path) {
+    viewer_export::MeshAttributes attributes;
+    attributes.scalars.push_back({"distance", result.unsigned_distance_m});
+    attributes.scalars.push_back({"signed_distance", result.signed_distance_m});
+    viewer_export::write_ply_mesh(*options.ply_path, estimate, attributes);
+  }
+  nlohmann::json json = mesh_comparison_json(result, settings);
+  json["estimate"] = options.estimate;
+  json["reference_file"] = options.reference;
+
+  char line[256];
+  std::string text;
+  const mesh::DistanceStatistics& a = result.accuracy;
+  std::snprintf(line, sizeof line, "points:       %zu (%zu beyond --max-dist)\n", result.points,
+                result.beyond_max_dist);
+  text += line;
+  std::snprintf(line, sizeof line,
+                "accuracy:     mean |d| %.4f m, mean %.4f, std %.4f, rmse %.4f, median %.4f, p95 "
+                "%.4f, max %.4f\n",
+                a.mean_abs, a.mean_signed, a.std_signed, a.rmse, a.median, a.p95, a.max);
+  text += line;
+  for (const mesh::ThresholdScores& s : result.scores) {
+    std::snprintf(line, sizeof line,
+                  "within %.2f m: completeness %.4f, precision %.4f, F-score %.4f\n", s.threshold_m,
+                  s.completeness, s.precision, s.fscore);
+    text += line;
+  }
+  emit(json, options.json_path, text);
+}
+
+}  // namespace
+
+std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/) {
+  CLI::App* eval = app.add_subcommand("eval", "Compare a trajectory or a mesh with ground truth");
+  eval->require_subcommand(1);
+
+  auto traj_options = std::make_shared<EvalTrajOptions>();
+  CLI::App* traj = eval->add_subcommand(
+      "traj", "Trajectory vs ground truth: APE, per-frame RPE, KITTI segment errors");
+  traj->add_option("EST", traj_options->estimate, "Estimated trajectory")->required();
+  traj->add_option("GT", traj_options->ground_truth, "Ground-truth trajectory")->required();
+  traj->add_option("--format", traj_options->format,
+                   "File format of both: tum, or kitti (no stamps: paired by index)")
+      ->check(CLI::IsMember({"tum", "kitti"}))
+      ->capture_default_str();
+  traj->add_option("--align", traj_options->align, "Umeyama alignment: se3, se3-scale or none")
+      ->check(CLI::IsMember({"se3", "se3-scale", "none"}))
+      ->capture_default_str();
+  traj->add_option("--max-diff", traj_options->max_diff_s,
+                   "Largest stamp difference of a pose pair, seconds")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  traj->add_option("--t-offset", traj_options->offset_s,
+                   "Added to the estimate's stamps before pairing (as evo's --t_offset), seconds")
+      ->capture_default_str();
+  traj->add_option("--est-times", traj_options->estimate_times,
+                   "KITTI: the estimate's times file (seconds, one a line); else paired by index");
+  traj->add_option("--gt-times", traj_options->ground_truth_times,
+                   "KITTI: the ground truth's times file (seconds, one a line)");
+  traj->add_option("--json", traj_options->json_path, "Write the figures as JSON ('-' = stdout)");
+  traj->add_option("--aligned-out", traj_options->aligned_path,
+                   "Write the paired, aligned estimate as TUM");
+
+  auto mesh_options = std::make_shared<EvalMeshOptions>();
+  CLI::App* mesh_command = eval->add_subcommand(
+      "mesh", "Mesh vs reference mesh or cloud: cloud-to-mesh accuracy, completeness, F-score");
+  mesh_command->add_option("MESH", mesh_options->estimate, "Estimated mesh (PLY)")->required();
+  mesh_command
+      ->add_option("REFERENCE", mesh_options->reference, "Reference mesh or point cloud (PLY)")
+      ->required();
+  mesh_command
+      ->add_option("--max-dist", mesh_options->max_dist_m,
+                   "Leave points farther than this out of the accuracy figures, metres")
+      ->check(CLI::NonNegativeNumber);
+  mesh_command
+      ->add_option("--samples-per-m2", mesh_options->samples_per_m2,
+                   "Samples of a reference mesh for completeness, per square metre")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  mesh_command->add_option("--json", mesh_options->json_path,
+                           "Write the figures as JSON ('-' = stdout)");
+  mesh_command->add_option("--ply-out", mesh_options->ply_path,
+                           "Write the mesh with scalar_distance and scalar_signed_distance");
+
+  return {{traj, [traj_options] { run_traj(*traj_options); }},
+          {mesh_command, [mesh_options] { run_mesh(*mesh_options); }}};
+}
+
+}  // namespace featsense::app
