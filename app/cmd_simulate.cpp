@@ -25,6 +25,7 @@
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "progress.hpp"
 
 namespace featsense::app {
@@ -68,10 +69,14 @@ double thread_cpu_ms() {
 
 /// The sensor's path; `start_stamp_ns` is set to the TUM file's first time, so that the
 /// frames and gt_trajectory.tum share the file's clock.
-std::unique_ptr<slam::Trajectory> make_trajectory(const SimulateOptions& o, bool builtin,
-                                                  int64_t* start_stamp_ns) {
+std::unique_ptr<slam::PoseCurve> make_trajectory(const SimulateOptions& o, bool builtin,
+                                                 int64_t* start_stamp_ns) {
   if (!o.trajectory_file.empty()) {
-    const std::vector<slam::StampedPose> poses = slam::read_tum(o.trajectory_file);
+    const std::vector<slam::StampedPose> poses =
+        slam::to_stamped_poses(slam::read_tum(o.trajectory_file));
+    if (poses.size() < 2) {
+      throw slam::TrajectoryError(o.trajectory_file + ": a trajectory needs at least two poses");
+    }
     *start_stamp_ns = static_cast<int64_t>(std::llround(poses.front().t_s * 1e9));
     return slam::make_sampled_trajectory(poses);
   }
@@ -100,7 +105,7 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   const slam::TriangleMesh mesh =
       builtin ? slam::build_scene(o.scene) : slam::load_mesh(o.scene, load);
   slam::SimulationSettings settings;
-  const std::unique_ptr<slam::Trajectory> trajectory =
+  const std::unique_ptr<slam::PoseCurve> trajectory =
       make_trajectory(o, builtin, &settings.start_stamp_ns);
 
   settings.sensor = sensor_model(o.sensor);

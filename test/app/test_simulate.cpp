@@ -15,10 +15,11 @@
 namespace featsense::test {
 namespace {
 
+/// Lines that hold data: not empty, not a '#' comment.
 size_t count_lines(const std::filesystem::path& path) {
   std::ifstream in(path);
   size_t n = 0;
-  for (std::string line; std::getline(in, line);) n += line.empty() ? 0 : 1;
+  for (std::string line; std::getline(in, line);) n += line.empty() || line[0] == '#' ? 0 : 1;
   return n;
 }
 

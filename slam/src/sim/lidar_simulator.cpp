@@ -28,7 +28,7 @@ void beam_geometry(const config::SensorModel& sensor, int row, int col, Eigen::V
 }
 
 LidarSimulator::LidarSimulator(const TriangleMesh& mesh, const RayCaster& caster,
-                               const Trajectory& trajectory, SimulationSettings settings)
+                               const PoseCurve& trajectory, SimulationSettings settings)
     : mesh_(mesh), caster_(caster), trajectory_(trajectory), settings_(std::move(settings)) {
   settings_.sensor.validate();
   const config::SensorModel& s = settings_.sensor;
@@ -158,7 +158,7 @@ SimulatedFrame LidarSimulator::simulate(uint64_t index) const {
   return frame;
 }
 
-void check_trajectory_inside(const Trajectory& trajectory, const TriangleMesh& mesh, double end_s,
+void check_trajectory_inside(const PoseCurve& trajectory, const TriangleMesh& mesh, double end_s,
                              double step_s, double margin_m) {
   Eigen::Vector3f lo, hi;
   mesh.bounds(&lo, &hi);

@@ -10,6 +10,7 @@
 
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/io/scan_writers.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "io/cloud/sequence_file.hpp"
 
 namespace featsense::slam {
@@ -105,10 +106,7 @@ void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d&
   write_scan_pcd(frame.scan, (std::filesystem::path(folder_) / name).string());
   files_.push_back(name);
   stamps_ns_.push_back(frame.scan.stamp_ns);
-  StampedPose pose;
-  pose.t_s = static_cast<double>(frame.scan.stamp_ns) * 1e-9;
-  pose.T_map_sensor = T_map_sensor;
-  poses_.push_back(pose);
+  trajectory_.push_back(frame.scan.stamp_ns, T_map_sensor);
   for (const Eigen::Vector3f& p : frame.surface_points_m) {
     if (insert_voxel(voxel_key(p, voxel_size_m_))) points_.push_back(p);
   }
@@ -145,7 +143,7 @@ void SimulationWriter::finish(const TriangleMesh& mesh) {
   std::ofstream yaml = open_for_writing(yaml_path);
   yaml << cloud::format_sequence_yaml(sequence);
   close_checked(yaml, yaml_path);
-  write_tum(poses_, (dir / "gt_trajectory.tum").string());
+  write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
   write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());
   write_points_ply(points_, (dir / "gt_points.ply").string());
 }

@@ -77,9 +77,9 @@ class CubicSpline {
   std::vector<Eigen::Vector3d> m_;
 };
 
-class SplineTrajectory final : public Trajectory {
+class SplinePoseCurve final : public PoseCurve {
  public:
-  SplineTrajectory(const std::vector<Eigen::Vector3d>& waypoints, double speed, bool tilt)
+  SplinePoseCurve(const std::vector<Eigen::Vector3d>& waypoints, double speed, bool tilt)
       : spline_(waypoints), speed_(speed), tilt_(tilt) {
     const std::vector<double>& u = spline_.knots();
     arc_.assign(u.size(), 0.0);
@@ -161,9 +161,9 @@ class SplineTrajectory final : public Trajectory {
   std::vector<double> arc_;  ///< arc length at each knot, metres
 };
 
-class SampledTrajectory final : public Trajectory {
+class SampledPoseCurve final : public PoseCurve {
  public:
-  explicit SampledTrajectory(std::vector<StampedPose> poses) : poses_(std::move(poses)) {
+  explicit SampledPoseCurve(std::vector<StampedPose> poses) : poses_(std::move(poses)) {
     const double t0 = poses_.front().t_s;
     for (StampedPose& p : poses_) p.t_s -= t0;
   }
@@ -191,71 +191,42 @@ class SampledTrajectory final : public Trajectory {
 
 }  // namespace
 
-std::unique_ptr<Trajectory> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
-                                                   double speed_mps, bool tilt) {
+std::unique_ptr<PoseCurve> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
+                                                  double speed_mps, bool tilt) {
   if (waypoints_m.size() < 2)
     throw std::invalid_argument("trajectory: a spline needs at least two waypoints");
   if (!(speed_mps > 0.0)) throw std::invalid_argument("trajectory: speed must be > 0 m/s");
-  return std::make_unique<SplineTrajectory>(waypoints_m, speed_mps, tilt);
+  return std::make_unique<SplinePoseCurve>(waypoints_m, speed_mps, tilt);
 }
 
-std::unique_ptr<Trajectory> make_sampled_trajectory(const std::vector<StampedPose>& poses) {
+std::unique_ptr<PoseCurve> make_sampled_trajectory(const std::vector<StampedPose>& poses) {
   if (poses.size() < 2) throw std::invalid_argument("trajectory: needs at least two poses");
   for (size_t i = 1; i < poses.size(); ++i) {
     if (!(poses[i].t_s > poses[i - 1].t_s))
       throw std::invalid_argument("trajectory: pose times must increase (pose " +
                                   std::to_string(i) + ")");
   }
-  return std::make_unique<SampledTrajectory>(poses);
+  return std::make_unique<SampledPoseCurve>(poses);
 }
 
-std::vector<StampedPose> read_tum(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the trajectory file");
+std::vector<StampedPose> to_stamped_poses(const Trajectory& trajectory) {
   std::vector<StampedPose> poses;
-  std::string line;
-  for (size_t number = 1; std::getline(in, line); ++number) {
-    const auto where = [&] { return path + ":" + std::to_string(number) + ": "; };
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
-    std::array<double, 8> v{};
-    for (double& x : v) {
-      if (!(fields >> x) || !std::isfinite(x))
-        throw InputError(where() + "expected 8 numbers 't x y z qx qy qz qw', got '" + line + "'");
-    }
-    std::string extra;
-    if (fields >> extra)
-      throw InputError(where() + "more than 8 values on the line: '" + line + "'");
-    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (std::abs(q.norm() - 1.0) > 1e-3)
-      throw InputError(where() + "the quaternion is not a unit quaternion (norm " +
-                       std::to_string(q.norm()) + ")");
-    if (!poses.empty() && !(v[0] > poses.back().t_s))
-      throw InputError(where() + "time " + std::to_string(v[0]) +
-                       " s does not increase over the line before");
+  poses.reserve(trajectory.size());
+  for (size_t i = 0; i < trajectory.size(); ++i) {
     StampedPose pose;
-    pose.t_s = v[0];
-    pose.T_map_sensor.linear() = q.normalized().toRotationMatrix();
-    pose.T_map_sensor.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    pose.t_s = 1e-9 * static_cast<double>(trajectory.stamps_ns[i]);
+    pose.T_map_sensor = trajectory.poses[i];
     poses.push_back(pose);
   }
-  if (poses.size() < 2) throw InputError(path + ": a trajectory needs at least two poses");
   return poses;
 }
 
-void write_tum(const std::vector<StampedPose>& poses, const std::string& path) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw WriteError(path + ": cannot write the trajectory");
-  char line[256];
-  for (const StampedPose& p : poses) {
-    const Eigen::Quaterniond q(p.T_map_sensor.rotation());
-    const Eigen::Vector3d& t = p.T_map_sensor.translation();
-    std::snprintf(line, sizeof line, "%.6f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", p.t_s,
-                  t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-    out << line;
+Trajectory to_trajectory(const std::vector<StampedPose>& poses) {
+  Trajectory trajectory;
+  for (const StampedPose& pose : poses) {
+    trajectory.push_back(std::llround(pose.t_s * 1e9), pose.T_map_sensor);
   }
-  if (!out) throw WriteError(path + ": writing the trajectory failed");
+  return trajectory;
 }
 
 }  // namespace featsense::slam

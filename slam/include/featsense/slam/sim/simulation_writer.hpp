@@ -17,6 +17,7 @@
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
 #include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
 
 namespace featsense::slam {
 
@@ -41,7 +42,7 @@ class SimulationWriter {
   double voxel_size_m_;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
-  std::vector<StampedPose> poses_;
+  Trajectory trajectory_;  ///< the true pose of each frame at its stamp
   /// Occupied voxel keys, open addressing with linear probing (0 = empty slot; keys are
   /// never 0): a node-based set spent more time than the simulation itself.
   std::vector<uint64_t> voxel_slots_;

@@ -1,6 +1,6 @@
 #pragma once
-/// Sensor trajectories for the simulator: smooth splines through waypoints at constant
-/// speed, or the poses of a TUM file; and TUM reading and writing.
+/// Sensor paths for the simulator: smooth splines through waypoints at constant speed, or
+/// poses interpolated between the samples of a trajectory file.
 
 #include <Eigen/Geometry>
 
@@ -8,13 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "featsense/slam/trajectory/trajectory.hpp"
+
 namespace featsense::slam {
 
 /// A pose over time. Times are seconds from the trajectory's start; poses map sensor
 /// coordinates into the map (T_map_sensor), Z up.
-class Trajectory {
+class PoseCurve {
  public:
-  virtual ~Trajectory() = default;
+  virtual ~PoseCurve() = default;
   /// Seconds from the start to the last pose.
   virtual double duration_s() const = 0;
   /// T_map_sensor at `t_s` seconds after the start (clamped to [0, duration]).
@@ -32,20 +34,16 @@ struct StampedPose {
 /// Yaw follows the direction of travel; with `tilt` the sensor also rolls into turns (by
 /// the lateral acceleration against gravity) and pitches with climbs. Throws
 /// std::invalid_argument for fewer than two waypoints, repeated waypoints or speed <= 0.
-std::unique_ptr<Trajectory> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
-                                                   double speed_mps, bool tilt = false);
+std::unique_ptr<PoseCurve> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
+                                                  double speed_mps, bool tilt = false);
 
 /// Poses interpolated between samples (linear in position, slerp in rotation); times are
 /// taken relative to the first sample. Throws std::invalid_argument for fewer than two
 /// samples or times that do not increase.
-std::unique_ptr<Trajectory> make_sampled_trajectory(const std::vector<StampedPose>& poses);
+std::unique_ptr<PoseCurve> make_sampled_trajectory(const std::vector<StampedPose>& poses);
 
-/// Reads a TUM trajectory; '#' comments and blank lines are skipped. Throws InputError
-/// naming the file and line for a malformed line, a non-unit quaternion or a time that
-/// does not increase.
-std::vector<StampedPose> read_tum(const std::string& path);
-/// Writes poses as TUM lines (time to the microsecond, which a double holds for Unix times;
-/// the pose at full precision). Throws WriteError naming the path.
-void write_tum(const std::vector<StampedPose>& poses, const std::string& path);
+/// The poses of a trajectory file (trajectory_io.hpp reads and writes TUM and KITTI), and back.
+std::vector<StampedPose> to_stamped_poses(const Trajectory& trajectory);
+Trajectory to_trajectory(const std::vector<StampedPose>& poses);
 
 }  // namespace featsense::slam
