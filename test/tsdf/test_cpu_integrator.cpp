@@ -2,6 +2,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "analytic_rays.hpp"
 #include "featsense/config/sensor_model.hpp"
@@ -185,6 +187,27 @@ TEST(CpuIntegrator, RaysOutsideTheMapAreClippedNotLost) {
     ASSERT_FLOAT_EQ(v.distance_m, s.truncation_m);  // only free space reaches the map
   });
   EXPECT_GT(observed, 1000u);
+}
+
+TEST(CpuIntegrator, BadPointsAreIgnoredAndBadBatchesRejected) {
+  const TsdfSettings s = test::small_map_settings();
+  RayBatch scan = wall_scan();
+  auto clean = make_cpu_integrator(s, test::make_vec(0, 0, 1));
+  clean->integrate(scan);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const Vec3 bad : {Vec3{nan, 0, 0}, Vec3{inf, 1, 1}, Vec3{1e20f, -1e20f, 3e38f},
+                         Vec3{0.0f, 0.0f, 1.0f}}) {  // the last one is the origin: zero length
+    scan.endpoints_m.push_back(bad);
+  }
+  auto dirty = make_cpu_integrator(s, test::make_vec(0, 0, 1));
+  dirty->integrate(scan);
+  EXPECT_TRUE(clean->download() == dirty->download());
+
+  RayBatch wrong = wall_scan();
+  wrong.origins_m.push_back(wrong.origins_m.front());  // two origins for many end points
+  EXPECT_THROW(dirty->integrate(wrong), std::invalid_argument);
+  EXPECT_EQ(dirty->integrate(RayBatch{}).rays, 0u);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 
 #include "analytic_rays.hpp"
 #include "featsense/slam/sim/box_room_source.hpp"
@@ -91,7 +92,13 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceOnAnalyticSurfaces) {
   const double centre[3] = {4.0, 1.0, 1.5};
   const config::SensorModel os1 = config::sensor_preset("os1-128");
   TsdfSettings s = test::small_map_settings();
-  expect_same_map(s, {test::cast_rays(os1, origin, test::plane(normal, -5.0))}, "plane");
+  RayBatch plane = test::cast_rays(os1, origin, test::plane(normal, -5.0));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Points no sensor should report, which both backends must ignore alike.
+  plane.endpoints_m.push_back({nan, 1.0f, 1.0f});
+  plane.endpoints_m.push_back({std::numeric_limits<float>::infinity(), 0.0f, 0.0f});
+  plane.endpoints_m.push_back({1e20f, -1e20f, 3e38f});
+  expect_same_map(s, {plane}, "plane and bad points");
   s.interpolation_slope = static_cast<float>(std::tan(os1.vertical_fov_rad() / os1.beams));
   expect_same_map(s, {test::cast_rays(os1, origin, test::sphere(centre, 1.5))}, "sphere+interp");
 }

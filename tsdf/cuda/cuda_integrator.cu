@@ -27,8 +27,8 @@ __global__ void mark_first_point_kernel(const Vec3* endpoints, uint32_t n, Local
                                         uint32_t* candidates) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  const Index3 v = map.voxel_of(endpoints[i]);
-  if (map.contains(v)) atomicMin(&candidates[map.linear(v)], i);
+  Index3 v;
+  if (map.voxel_in_map(endpoints[i], v)) atomicMin(&candidates[map.linear(v)], i);
 }
 
 /// Phase 2: the rays to march (the first point of each voxel, every point outside the map),
@@ -37,9 +37,9 @@ __global__ void select_rays_kernel(const Vec3* endpoints, uint32_t n, LocalMapGe
                                    uint32_t* candidates, uint32_t* kept, uint32_t* kept_count) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  const Index3 v = map.voxel_of(endpoints[i]);
+  Index3 v;
   bool keep = true;
-  if (map.contains(v)) {
+  if (map.voxel_in_map(endpoints[i], v)) {
     uint32_t* slot = &candidates[map.linear(v)];
     keep = *slot == i;
     // The winner resets the slot at once: a loser reading it afterwards sees
@@ -149,6 +149,7 @@ class CudaIntegrator final : public Integrator {
   }
 
   IntegrationStats integrate(const RayBatch& rays) override {
+    check_ray_batch(rays);
     const uint32_t n = static_cast<uint32_t>(rays.size());
     IntegrationStats stats;
     if (n == 0) return stats;

@@ -48,6 +48,7 @@ class CpuIntegrator final : public Integrator {
   }
 
   IntegrationStats integrate(const RayBatch& rays) override {
+    check_ray_batch(rays);
     const std::vector<uint32_t> kept = rays_to_march(rays);
     detail::RayMarchParams params;
     params.truncation_m = settings_.truncation_m;
@@ -95,15 +96,15 @@ class CpuIntegrator final : public Integrator {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& range) {
                         for (size_t i = range.begin(); i != range.end(); ++i) {
-                          const Index3 v = geometry_.voxel_of(rays.endpoints_m[i]);
-                          if (geometry_.contains(v)) {
+                          Index3 v;
+                          if (geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
                             atomic_min(candidates_[geometry_.linear(v)], static_cast<uint32_t>(i));
                           }
                         }
                       });
     for (size_t i = 0; i < rays.size(); ++i) {
-      const Index3 v = geometry_.voxel_of(rays.endpoints_m[i]);
-      if (!geometry_.contains(v)) {
+      Index3 v;
+      if (!geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
         kept.push_back(static_cast<uint32_t>(i));
         continue;
       }

@@ -52,7 +52,8 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
                                    const RayMarchParams& params, Visit&& visit) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
-  if (!(range > 0.0f)) return;
+  // NaN, zero and infinite rays (a NaN or absurd point or origin) propose nothing.
+  if (!(range > 0.0f && range < 1.0e30f)) return;
   const Vec3 dir = (1.0f / range) * delta;
   float t0 = 0.0f;
   float t1 = range + params.truncation_m;

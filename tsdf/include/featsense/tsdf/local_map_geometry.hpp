@@ -86,6 +86,18 @@ struct LocalMapGeometry {
             (static_cast<float>(g.y) + 0.5f) * voxel_size_m,
             (static_cast<float>(g.z) + 0.5f) * voxel_size_m};
   }
+  /// The voxel of map-frame point p when p lies inside the local map; false for points
+  /// outside it and for NaN. Points from outside must be checked in metres first: voxel
+  /// indices are 32-bit, and a far-away point would overflow them.
+  FEATSENSE_HD_INLINE bool voxel_in_map(Vec3 p, Index3& voxel) const {
+    const Vec3 lo = min_corner();
+    const Vec3 hi = max_corner();
+    if (!(p.x >= lo.x && p.x < hi.x && p.y >= lo.y && p.y < hi.y && p.z >= lo.z && p.z < hi.z)) {
+      return false;
+    }
+    voxel = voxel_of(p);
+    return contains(voxel);
+  }
   /// Lowest and highest corner of the local map, metres.
   FEATSENSE_HD_INLINE Vec3 min_corner() const {
     return {static_cast<float>(origin.x) * voxel_size_m,

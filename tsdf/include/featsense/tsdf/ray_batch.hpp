@@ -18,4 +18,7 @@ struct RayBatch {
   Vec3 origin(size_t i) const { return origins_m.size() == 1 ? origins_m[0] : origins_m[i]; }
 };
 
+/// Throws std::invalid_argument unless there is one origin, or one per end point.
+void check_ray_batch(const RayBatch& rays);
+
 }  // namespace featsense::tsdf
