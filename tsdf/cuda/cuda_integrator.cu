@@ -11,6 +11,7 @@
 #include "cuda_check.hpp"
 #include "device_buffer.hpp"
 #include "featsense/tsdf/integrator.hpp"
+#include "parallel_copy.hpp"
 #include "ray_marcher.hpp"
 
 namespace featsense::tsdf {
@@ -204,8 +205,8 @@ class CudaIntegrator final : public Integrator {
     staging_.reserve(n + origin_count);
     endpoints_.reserve(n);
     origins_.reserve(origin_count);
-    std::memcpy(staging_.data(), rays.endpoints_m.data(), n * sizeof(Vec3));
-    std::memcpy(staging_.data() + n, rays.origins_m.data(), origin_count * sizeof(Vec3));
+    detail::parallel_copy(staging_.data(), rays.endpoints_m.data(), n * sizeof(Vec3));
+    detail::parallel_copy(staging_.data() + n, rays.origins_m.data(), origin_count * sizeof(Vec3));
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(endpoints_.data(), staging_.data(), n * sizeof(Vec3),
                                          cudaMemcpyHostToDevice, stream_));
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(origins_.data(), staging_.data() + n,
