@@ -26,7 +26,7 @@ bool same_length(double a, double b) {
 
 std::string format_length(double metres) {
   std::ostringstream out;
-  out.precision(17);
+  out.precision(10);  // enough to tell settings apart, short enough to read
   out << metres << " m";
   return out.str();
 }
