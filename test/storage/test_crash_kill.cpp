@@ -23,16 +23,18 @@ using test::test_metadata;
 /// The i-th key the child writes, spread over negative and positive coordinates.
 ChunkKey key_of(int32_t i) { return {i % 5 - 2, (i / 5) % 5 - 2, i / 25 - 2}; }
 
-StoreSettings child_settings() {
+StoreSettings child_settings(std::size_t journal_limit_bytes) {
   StoreSettings settings;
   settings.cache_bytes = 3 * kChunkBytes;
-  settings.journal_limit_bytes = 4u << 20;  // a checkpoint every few flushes
+  settings.journal_limit_bytes = journal_limit_bytes;
   return settings;
 }
 
-[[noreturn]] void run_child(const std::filesystem::path& path, int report_fd) {
+[[noreturn]] void run_child(const std::filesystem::path& path, std::size_t journal_limit_bytes,
+                            int report_fd) {
   try {
-    Hdf5ChunkStore store(path, OpenMode::kAppend, test_metadata(), child_settings());
+    Hdf5ChunkStore store(path, OpenMode::kAppend, test_metadata(),
+                         child_settings(journal_limit_bytes));
     for (int32_t i = 0; i < 100000; ++i) {
       store.write(key_of(i), make_chunk(static_cast<uint32_t>(i)));
       store.flush();
@@ -45,13 +47,14 @@ StoreSettings child_settings() {
 }
 
 /// Starts the child, kills it after `reports` flushed keys, returns every key it reported.
-std::set<int32_t> crash_after(const std::filesystem::path& path, int reports) {
+std::set<int32_t> crash_after(const std::filesystem::path& path, std::size_t journal_limit_bytes,
+                              int reports) {
   int fds[2];
   if (::pipe(fds) != 0) return {};
   const pid_t child = ::fork();
   if (child == 0) {
     ::close(fds[0]);
-    run_child(path, fds[1]);
+    run_child(path, journal_limit_bytes, fds[1]);
   }
   ::close(fds[1]);
   std::set<int32_t> reported;
@@ -68,26 +71,35 @@ std::set<int32_t> crash_after(const std::filesystem::path& path, int reports) {
   return reported;
 }
 
-TEST(CrashKill, EveryReportedChunkSurvivesSigkill) {
-  for (const int reports : {3, 11, 29}) {
-    const auto path = test::scratch_dir("crash_kill_" + std::to_string(reports)) / "map.h5";
-    { Hdf5ChunkStore create(path, OpenMode::kCreate, test_metadata()); }
-    const std::set<int32_t> reported = crash_after(path, reports);
-    ASSERT_GE(static_cast<int>(reported.size()), reports);
+void check_crash(const std::string& name, std::size_t journal_limit_bytes, int reports) {
+  const auto path = test::scratch_dir(name + "_" + std::to_string(reports)) / "map.h5";
+  { Hdf5ChunkStore create(path, OpenMode::kCreate, test_metadata()); }
+  const std::set<int32_t> reported = crash_after(path, journal_limit_bytes, reports);
+  ASSERT_GE(static_cast<int>(reported.size()), reports);
 
-    Hdf5ChunkStore store(path);
-    for (const int32_t i : reported) {
-      const auto chunk = store.read(key_of(i));
-      ASSERT_TRUE(chunk.has_value()) << "flushed chunk " << i << " lost";
-      EXPECT_TRUE(*chunk == make_chunk(static_cast<uint32_t>(i))) << "chunk " << i;
-    }
-    // At most the one chunk flushed but not yet reported may be there besides.
-    EXPECT_LE(store.keys().size(), reported.size() + 1);
-    for (const auto& key : store.keys()) {
-      const int32_t i = (key.x + 2) + 5 * (key.y + 2) + 25 * (key.z + 2);
-      EXPECT_TRUE(*store.read(key) == make_chunk(static_cast<uint32_t>(i))) << "chunk " << i;
-    }
+  Hdf5ChunkStore store(path);
+  for (const int32_t i : reported) {
+    const auto chunk = store.read(key_of(i));
+    ASSERT_TRUE(chunk.has_value()) << "flushed chunk " << i << " lost";
+    EXPECT_TRUE(*chunk == make_chunk(static_cast<uint32_t>(i))) << "chunk " << i;
   }
+  // At most the one chunk flushed but not yet reported may be there besides.
+  EXPECT_LE(store.keys().size(), reported.size() + 1);
+  for (const auto& key : store.keys()) {
+    const int32_t i = (key.x + 2) + 5 * (key.y + 2) + 25 * (key.z + 2);
+    EXPECT_TRUE(*store.read(key) == make_chunk(static_cast<uint32_t>(i))) << "chunk " << i;
+  }
+}
+
+TEST(CrashKill, EveryReportedChunkSurvivesSigkill) {
+  // A checkpoint every dozen flushes or so: the kill mostly lands in a journal append.
+  for (const int reports : {3, 11, 29}) check_crash("crash_kill", 4u << 20, reports);
+}
+
+TEST(CrashKill, KillDuringCheckpointsLosesNothing) {
+  // A checkpoint after every flush: the kill mostly lands while a new .h5 is written or
+  // renamed into place.
+  for (const int reports : {2, 7, 15}) check_crash("crash_kill_checkpoint", 1, reports);
 }
 
 }  // namespace
