@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <set>
+#include <utility>
 
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
@@ -46,9 +47,10 @@ StoreSettings child_settings(std::size_t journal_limit_bytes) {
   ::_exit(0);
 }
 
-/// Starts the child, kills it after `reports` flushed keys, returns every key it reported.
+/// Starts the child, kills it `delay_us` after its `reports`-th flushed key, returns every
+/// key it reported.
 std::set<int32_t> crash_after(const std::filesystem::path& path, std::size_t journal_limit_bytes,
-                              int reports) {
+                              int reports, int delay_us) {
   int fds[2];
   if (::pipe(fds) != 0) return {};
   const pid_t child = ::fork();
@@ -61,6 +63,8 @@ std::set<int32_t> crash_after(const std::filesystem::path& path, std::size_t jou
   int32_t i = 0;
   while (static_cast<int>(reported.size()) < reports && ::read(fds[0], &i, sizeof(i)) == sizeof(i))
     reported.insert(i);
+  // Without a delay the kill would always land just after a report, at the same step.
+  ::usleep(static_cast<useconds_t>(delay_us));
   ::kill(child, SIGKILL);
   int status = 0;
   ::waitpid(child, &status, 0);
@@ -71,10 +75,11 @@ std::set<int32_t> crash_after(const std::filesystem::path& path, std::size_t jou
   return reported;
 }
 
-void check_crash(const std::string& name, std::size_t journal_limit_bytes, int reports) {
+void check_crash(const std::string& name, std::size_t journal_limit_bytes, int reports,
+                 int delay_us) {
   const auto path = test::scratch_dir(name + "_" + std::to_string(reports)) / "map.h5";
   { Hdf5ChunkStore create(path, OpenMode::kCreate, test_metadata()); }
-  const std::set<int32_t> reported = crash_after(path, journal_limit_bytes, reports);
+  const std::set<int32_t> reported = crash_after(path, journal_limit_bytes, reports, delay_us);
   ASSERT_GE(static_cast<int>(reported.size()), reports);
 
   Hdf5ChunkStore store(path);
@@ -93,13 +98,15 @@ void check_crash(const std::string& name, std::size_t journal_limit_bytes, int r
 
 TEST(CrashKill, EveryReportedChunkSurvivesSigkill) {
   // A checkpoint every dozen flushes or so: the kill mostly lands in a journal append.
-  for (const int reports : {3, 11, 29}) check_crash("crash_kill", 4u << 20, reports);
+  for (const auto& [reports, delay_us] : {std::pair{3, 0}, {11, 2000}, {29, 7000}})
+    check_crash("crash_kill", 4u << 20, reports, delay_us);
 }
 
 TEST(CrashKill, KillDuringCheckpointsLosesNothing) {
   // A checkpoint after every flush: the kill mostly lands while a new .h5 is written or
   // renamed into place.
-  for (const int reports : {2, 7, 15}) check_crash("crash_kill_checkpoint", 1, reports);
+  for (const auto& [reports, delay_us] : {std::pair{2, 5000}, {7, 20000}, {15, 40000}})
+    check_crash("crash_kill_checkpoint", 1, reports, delay_us);
 }
 
 }  // namespace
