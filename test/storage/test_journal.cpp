@@ -114,6 +114,27 @@ TEST(Journal, CorruptLastRecordIsIgnored) {
       });
 }
 
+TEST(Journal, GrowingPastItsLimitFoldsIntoTheH5) {
+  const auto path = test::scratch_dir("journal_limit") / "map.h5";
+  StoreSettings settings = no_checkpoint();
+  settings.journal_limit_bytes = 1u << 20;
+  {
+    Hdf5ChunkStore store(path, OpenMode::kCreate, test_metadata(), settings);
+    for (uint32_t i = 0; i < 12; ++i) {
+      store.write({static_cast<int32_t>(i), -1, 0}, make_chunk(i));
+      store.flush();
+      EXPECT_LE(store.journal_bytes(), settings.journal_limit_bytes);
+    }
+  }
+  // Without the journal, the .h5 alone holds every chunk up to the last checkpoint.
+  const auto journal_size = std::filesystem::file_size(journal_of(path));
+  std::filesystem::remove(journal_of(path));
+  Hdf5ChunkStore store(path);
+  EXPECT_GE(store.keys().size(), 12u - journal_size / 100000);  // records are > 100 kB here
+  for (const auto& key : store.keys())
+    EXPECT_TRUE(*store.read(key) == make_chunk(static_cast<uint32_t>(key.x)));
+}
+
 TEST(Journal, ForeignJournalIsAnError) {
   const auto path = test::scratch_dir("journal_foreign") / "map.h5";
   { Hdf5ChunkStore store(path, OpenMode::kCreate, test_metadata()); }
