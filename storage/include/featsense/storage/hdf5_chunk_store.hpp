@@ -1,0 +1,112 @@
+#pragma once
+/// The global map in an HDF5 file (layout in storage/FORMAT.md) with a journal beside it
+/// (`<path>.journal`) that makes every flush durable: after a crash at any moment the map
+/// opens with every chunk flushed before it. Recently used chunks stay in an LRU cache.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "featsense/storage/chunk_store.hpp"
+
+namespace featsense::storage {
+
+namespace detail {
+class Journal;
+class Hdf5MapReader;
+}  // namespace detail
+
+enum class OpenMode {
+  kCreate,           ///< a new map; an error if the file exists
+  kCreateOverwrite,  ///< a new map, replacing an existing file and its journal
+  kAppend,           ///< continue an existing map; metadata must match
+  kReadOnly,         ///< read an existing map; writes are errors
+};
+
+struct StoreSettings {
+  std::size_t cache_bytes = std::size_t{256} << 20;  ///< LRU limit, bytes (>= one chunk kept)
+  /// A flush folds the journal into the .h5 once the journal is this large, bytes.
+  std::size_t journal_limit_bytes = std::size_t{512} << 20;
+  /// Fold the journal into the .h5 at close. Off only to leave the map as a crash would.
+  bool checkpoint_on_close = true;
+  int deflate_level = 3;  ///< 0-9, for the .h5 chunk datasets and the journal records
+};
+
+class Hdf5ChunkStore final : public ChunkStore {
+ public:
+  /// kCreate*: `metadata` is written. kAppend: `metadata` must match the file's voxel size,
+  /// tau and encoding, else std::runtime_error naming both values. kReadOnly: `metadata` is
+  /// ignored. Every failure (missing, unwritable, foreign or damaged file) throws
+  /// std::runtime_error with the path in the message.
+  Hdf5ChunkStore(const std::filesystem::path& path, OpenMode mode, const MapMetadata& metadata,
+                 const StoreSettings& settings = {});
+  /// Opens an existing map read-only.
+  explicit Hdf5ChunkStore(const std::filesystem::path& path, const StoreSettings& settings = {});
+  /// Calls close(); errors there are swallowed (call close() to see them).
+  ~Hdf5ChunkStore() override;
+
+  Hdf5ChunkStore(const Hdf5ChunkStore&) = delete;
+  Hdf5ChunkStore& operator=(const Hdf5ChunkStore&) = delete;
+
+  std::optional<Chunk> read(const ChunkKey& key) override;
+  void write(const ChunkKey& key, const Chunk& chunk) override;
+  std::vector<ChunkKey> keys() const override;
+  void flush() override;
+  const MapMetadata& metadata() const override { return metadata_; }
+
+  /// Replaces the stored trajectory (durable at the next flush).
+  void write_trajectory(const std::vector<TrajectoryPose>& poses);
+  std::vector<TrajectoryPose> read_trajectory() const { return trajectory_; }
+
+  /// Flushes, then writes a new .h5 holding everything, replaces the old one atomically and
+  /// empties the journal.
+  void checkpoint();
+  /// Flushes and (per settings) checkpoints; the store is unusable afterwards.
+  void close();
+
+  const std::filesystem::path& path() const { return path_; }
+  std::size_t journal_bytes() const;
+
+ private:
+  struct Location {
+    bool in_journal = false;  ///< else in the .h5
+    uint64_t offset = 0;      ///< of the record's payload in the journal, bytes
+    uint32_t size = 0;        ///< payload size, bytes
+  };
+  struct CacheEntry {
+    Chunk chunk;
+    bool dirty = false;
+    std::list<ChunkKey>::iterator lru;
+  };
+
+  void open_existing(OpenMode mode, const MapMetadata* expected);
+  void require_writable(const char* what) const;
+  void touch(CacheEntry& entry);
+  void evict_if_needed();
+  void append_to_journal(const ChunkKey& key, const Chunk& chunk);
+  Chunk load(const ChunkKey& key, const Location& where) const;
+
+  std::filesystem::path path_;
+  StoreSettings settings_;
+  MapMetadata metadata_;
+  bool writable_ = false;
+  bool closed_ = false;
+  std::unique_ptr<detail::Hdf5MapReader> file_;
+  std::unique_ptr<detail::Journal> journal_;
+  std::map<ChunkKey, Location> stored_;  ///< durable chunks (journal wins over the .h5)
+  std::set<ChunkKey> present_;           ///< every key holding a chunk now, durable or not
+  std::unordered_map<ChunkKey, CacheEntry, ChunkKeyHash> cache_;
+  std::list<ChunkKey> lru_;  ///< front = most recently used
+  std::vector<TrajectoryPose> trajectory_;
+  bool trajectory_dirty_ = false;
+};
+
+}  // namespace featsense::storage

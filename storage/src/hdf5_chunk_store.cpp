@@ -1,0 +1,300 @@
+#include "featsense/storage/hdf5_chunk_store.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+
+#include "chunk_codec.hpp"
+#include "file_ops.hpp"
+#include "hdf5_map_file.hpp"
+#include "journal.hpp"
+
+namespace featsense::storage {
+
+namespace {
+
+std::filesystem::path with_suffix(const std::filesystem::path& path, const char* suffix) {
+  return std::filesystem::path(path.string() + suffix);
+}
+
+bool same_length(double a, double b) {
+  // Lengths come from the same YAML text; a relative 1e-9 only forgives a decimal round trip.
+  return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
+}
+
+std::string format_length(double metres) {
+  std::ostringstream out;
+  out.precision(10);  // enough to tell settings apart, short enough to read
+  out << metres << " m";
+  return out.str();
+}
+
+void check_compatible(const MapMetadata& file, const MapMetadata& wanted,
+                      const std::filesystem::path& path) {
+  std::string problems;
+  if (!same_length(file.voxel_size_m, wanted.voxel_size_m))
+    problems += " voxel size: map " + format_length(file.voxel_size_m) + ", this run " +
+                format_length(wanted.voxel_size_m) + ";";
+  if (!same_length(file.truncation_m, wanted.truncation_m))
+    problems += " truncation (tau): map " + format_length(file.truncation_m) + ", this run " +
+                format_length(wanted.truncation_m) + ";";
+  if (file.value_scale != wanted.value_scale || file.weight_scale != wanted.weight_scale)
+    problems += " voxel encoding: map value/weight scale " + std::to_string(file.value_scale) +
+                "/" + std::to_string(file.weight_scale) + ", this run " +
+                std::to_string(wanted.value_scale) + "/" + std::to_string(wanted.weight_scale) +
+                ";";
+  if (!problems.empty())
+    throw std::runtime_error("cannot continue the map " + path.string() +
+                             ", its settings differ:" + problems);
+}
+
+std::vector<uint8_t> trajectory_bytes(const std::vector<TrajectoryPose>& poses) {
+  std::vector<uint8_t> bytes(poses.size() * sizeof(TrajectoryPose));
+  if (!bytes.empty()) std::memcpy(bytes.data(), poses.data(), bytes.size());
+  return bytes;
+}
+
+}  // namespace
+
+Hdf5ChunkStore::Hdf5ChunkStore(const std::filesystem::path& path, OpenMode mode,
+                               const MapMetadata& metadata, const StoreSettings& settings)
+    : path_(path), settings_(settings), metadata_(metadata) {
+  if (mode == OpenMode::kAppend || mode == OpenMode::kReadOnly) {
+    open_existing(mode, mode == OpenMode::kAppend ? &metadata : nullptr);
+    return;
+  }
+  if (mode == OpenMode::kCreate && std::filesystem::exists(path))
+    throw std::runtime_error("map already exists (open it to append, or overwrite it): " +
+                             path.string());
+  if (!(metadata.voxel_size_m > 0.0) || !(metadata.truncation_m > 0.0))
+    throw std::invalid_argument("map metadata needs a positive voxel size and tau: " +
+                                path.string());
+  metadata_.format_version = kFormatVersion;
+  metadata_.chunk_size = kChunkSize;
+  writable_ = true;
+  // The journal is emptied first: records of a map being overwritten must never be replayed
+  // over the new one.
+  journal_ = std::make_unique<detail::Journal>(with_suffix(path, ".journal"), true, true);
+  const auto tmp = with_suffix(path, ".tmp");
+  {
+    detail::Hdf5MapWriter writer(tmp, metadata_, settings_.deflate_level);
+    writer.close();
+  }
+  detail::replace_file(tmp, path);
+  file_ = std::make_unique<detail::Hdf5MapReader>(path);
+}
+
+Hdf5ChunkStore::Hdf5ChunkStore(const std::filesystem::path& path, const StoreSettings& settings)
+    : Hdf5ChunkStore(path, OpenMode::kReadOnly, MapMetadata{}, settings) {}
+
+Hdf5ChunkStore::~Hdf5ChunkStore() {
+  try {
+    close();
+  } catch (...) {
+    // A destructor must not throw; callers that care call close() themselves.
+  }
+}
+
+void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
+  writable_ = mode == OpenMode::kAppend;
+  file_ = std::make_unique<detail::Hdf5MapReader>(path_);
+  metadata_ = file_->metadata();
+  if (expected != nullptr) check_compatible(metadata_, *expected, path_);
+  for (const auto& key : file_->keys()) {
+    stored_[key] = Location{};
+    present_.insert(key);
+  }
+  trajectory_ = file_->read_trajectory();
+
+  journal_ = std::make_unique<detail::Journal>(with_suffix(path_, ".journal"), writable_, false);
+  for (const auto& record : journal_->replay()) {
+    if (record.type == detail::RecordType::kTrajectory) {
+      const auto bytes = journal_->read_payload(record.payload_offset, record.payload_size);
+      trajectory_.resize(bytes.size() / sizeof(TrajectoryPose));
+      if (!trajectory_.empty())
+        std::memcpy(trajectory_.data(), bytes.data(), trajectory_.size() * sizeof(TrajectoryPose));
+    } else if (record.payload_size == 0) {
+      stored_.erase(record.key);
+      present_.erase(record.key);
+    } else {
+      stored_[record.key] = Location{true, record.payload_offset, record.payload_size};
+      present_.insert(record.key);
+    }
+  }
+  // A checkpoint interrupted by a crash leaves its unfinished copy behind.
+  if (writable_) std::filesystem::remove(with_suffix(path_, ".tmp"));
+}
+
+void Hdf5ChunkStore::require_writable(const char* what) const {
+  if (closed_) throw std::logic_error(std::string(what) + " on a closed map: " + path_.string());
+  if (!writable_)
+    throw std::logic_error(std::string(what) + " on a map opened read-only: " + path_.string());
+}
+
+void Hdf5ChunkStore::touch(CacheEntry& entry) { lru_.splice(lru_.begin(), lru_, entry.lru); }
+
+Chunk Hdf5ChunkStore::load(const ChunkKey& key, const Location& where) const {
+  if (!where.in_journal) return file_->read(key);
+  const auto bytes =
+      detail::decompress_bytes(journal_->read_payload(where.offset, where.size), kChunkBytes);
+  Chunk chunk;
+  std::memcpy(chunk.voxels.data(), bytes.data(), kChunkBytes);
+  return chunk;
+}
+
+std::optional<Chunk> Hdf5ChunkStore::read(const ChunkKey& key) {
+  if (closed_) throw std::logic_error("read on a closed map: " + path_.string());
+  if (present_.count(key) == 0) return std::nullopt;
+  if (auto it = cache_.find(key); it != cache_.end()) {
+    touch(it->second);
+    return it->second.chunk;
+  }
+  Chunk chunk = load(key, stored_.at(key));
+  lru_.push_front(key);
+  cache_.emplace(key, CacheEntry{chunk, false, lru_.begin()});
+  evict_if_needed();
+  return chunk;
+}
+
+void Hdf5ChunkStore::write(const ChunkKey& key, const Chunk& chunk) {
+  require_writable("write");
+  if (chunk.voxels.size() != kChunkVoxels)
+    throw std::invalid_argument("a chunk holds 64^3 voxels, got " +
+                                std::to_string(chunk.voxels.size()));
+  auto it = cache_.find(key);
+  if (is_empty(chunk)) {
+    present_.erase(key);
+    if (stored_.count(key) == 0) {
+      // Never durable: nothing to remove on disk.
+      if (it != cache_.end()) {
+        lru_.erase(it->second.lru);
+        cache_.erase(it);
+      }
+      return;
+    }
+  } else {
+    present_.insert(key);
+  }
+  if (it == cache_.end()) {
+    lru_.push_front(key);
+    cache_.emplace(key, CacheEntry{chunk, true, lru_.begin()});
+  } else {
+    it->second.chunk = chunk;
+    it->second.dirty = true;
+    touch(it->second);
+  }
+  evict_if_needed();
+}
+
+void Hdf5ChunkStore::evict_if_needed() {
+  const std::size_t capacity = std::max<std::size_t>(1, settings_.cache_bytes / kChunkBytes);
+  while (cache_.size() > capacity) {
+    const ChunkKey victim = lru_.back();
+    auto it = cache_.find(victim);
+    if (it->second.dirty) append_to_journal(victim, it->second.chunk);
+    lru_.pop_back();
+    cache_.erase(it);
+  }
+}
+
+void Hdf5ChunkStore::append_to_journal(const ChunkKey& key, const Chunk& chunk) {
+  if (is_empty(chunk)) {
+    journal_->append(detail::RecordType::kChunk, key, {});
+    stored_.erase(key);
+    return;
+  }
+  const auto payload = detail::compress_bytes(reinterpret_cast<const uint8_t*>(chunk.voxels.data()),
+                                              kChunkBytes, settings_.deflate_level);
+  const uint64_t offset = journal_->append(detail::RecordType::kChunk, key, payload);
+  stored_[key] = Location{true, offset, static_cast<uint32_t>(payload.size())};
+}
+
+std::vector<ChunkKey> Hdf5ChunkStore::keys() const {
+  return std::vector<ChunkKey>(present_.begin(), present_.end());
+}
+
+void Hdf5ChunkStore::write_trajectory(const std::vector<TrajectoryPose>& poses) {
+  require_writable("write_trajectory");
+  trajectory_ = poses;
+  trajectory_dirty_ = true;
+}
+
+void Hdf5ChunkStore::flush() {
+  if (closed_ || !writable_) return;
+  std::vector<ChunkKey> dirty;
+  for (const auto& [key, entry] : cache_)
+    if (entry.dirty) dirty.push_back(key);
+  std::sort(dirty.begin(), dirty.end());
+  for (const auto& key : dirty) {
+    auto& entry = cache_.at(key);
+    append_to_journal(key, entry.chunk);
+    entry.dirty = false;
+  }
+  if (trajectory_dirty_) {
+    journal_->append(detail::RecordType::kTrajectory, {}, trajectory_bytes(trajectory_));
+    trajectory_dirty_ = false;
+  }
+  journal_->sync();
+  if (journal_->size_bytes() > settings_.journal_limit_bytes) checkpoint();
+}
+
+void Hdf5ChunkStore::checkpoint() {
+  require_writable("checkpoint");
+  if (trajectory_dirty_ ||
+      std::any_of(cache_.begin(), cache_.end(), [](const auto& kv) { return kv.second.dirty; })) {
+    // Only the journal and the old file are copied below, so everything must be in them.
+    const std::size_t limit = settings_.journal_limit_bytes;
+    settings_.journal_limit_bytes = SIZE_MAX;
+    try {
+      flush();
+    } catch (...) {
+      settings_.journal_limit_bytes = limit;
+      throw;
+    }
+    settings_.journal_limit_bytes = limit;
+  }
+  const auto tmp = with_suffix(path_, ".tmp");
+  try {
+    detail::Hdf5MapWriter writer(tmp, metadata_, settings_.deflate_level);
+    for (const auto& key : present_) {
+      const Location& where = stored_.at(key);
+      if (where.in_journal)
+        writer.write_chunk(key, load(key, where));
+      else
+        writer.copy_chunk(*file_, key);
+    }
+    writer.write_trajectory(trajectory_);
+    writer.close();
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
+  // From here a crash leaves either the old file with the whole journal, or the new file
+  // with a journal whose records it already holds: replaying them again changes nothing.
+  detail::replace_file(tmp, path_);
+  file_ = std::make_unique<detail::Hdf5MapReader>(path_);
+  journal_->reset();
+  for (auto& [key, where] : stored_) where = Location{};
+}
+
+void Hdf5ChunkStore::close() {
+  if (closed_) return;
+  if (writable_) {
+    flush();
+    if (settings_.checkpoint_on_close) checkpoint();
+  }
+  closed_ = true;
+  cache_.clear();
+  lru_.clear();
+  journal_.reset();
+  file_.reset();
+}
+
+std::size_t Hdf5ChunkStore::journal_bytes() const {
+  return journal_ ? static_cast<std::size_t>(journal_->size_bytes()) : 0;
+}
+
+}  // namespace featsense::storage
