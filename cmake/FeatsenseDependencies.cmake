@@ -11,9 +11,12 @@ find_package(BZip2 REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
-# The simulator: Embree casts the rays, assimp reads scene meshes (both only in slam/src/sim).
+# The simulator: Embree casts the rays, assimp reads scene meshes (slam/src/sim); assimp also
+# reads glTF/OBJ meshes back in viewer_export.
 find_package(embree 3 CONFIG REQUIRED)
 find_package(assimp CONFIG REQUIRED)
+# The mesh navigation HDF5 export (viewer_export/src/mesh_nav_h5_writer.cpp only).
+find_package(HDF5 REQUIRED COMPONENTS C)
 # CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings
 # never fail our build. Only mesh/src/closest_point_query.cpp includes it.
 find_package(CGAL CONFIG REQUIRED)
