@@ -93,6 +93,13 @@ TEST(CliNavmesh, LayersAndLethalFaces) {
       EXPECT_NE(header.find("property float scalar_" + layer + "\n"), std::string::npos) << layer;
     }
     EXPECT_NE(header.find("property uchar red"), std::string::npos);
+    viewer_export::MeshAttributes layers;
+    viewer_export::read_mesh(out, &layers);
+    ASSERT_EQ(layers.scalars.size(), 5u);
+    ASSERT_EQ(layers.scalars[0].name, "inclination_deg");
+    for (const float inclination : layers.scalars[0].values) {
+      EXPECT_NEAR(inclination, slope_deg, 2e-3);
+    }
   }
   const std::string ramp = (dir / "ramp.ply").string();
   for (const std::string name : {"nav.glb", "nav.h5"}) {

@@ -62,6 +62,30 @@ TEST(MeshWriter, BadInputGivesClearErrors) {
   }
 }
 
+TEST(MeshWriter, PlyRoundTripKeepsColoursAndLayers) {
+  const std::filesystem::path dir = scratch_dir("mesh_writer_ply_layers");
+  viewer_export::MeshAttributes attributes;
+  attributes.colors = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}, {250, 251, 252}};
+  attributes.scalars = {{"inclination_deg", {0.5f, 1.0f / 3.0f, 45.0f, -2.0f}},
+                        {"cost", {0.0f, 0.25f, 1.0f, 0.75f}}};
+  for (const bool ascii : {false, true}) {
+    const std::string path = (dir / (ascii ? "ascii.ply" : "binary.ply")).string();
+    viewer_export::MeshWriteSettings settings;
+    settings.ply_ascii = ascii;
+    viewer_export::write_mesh(path, two_triangles(), attributes, settings);
+    viewer_export::MeshAttributes read_attributes;
+    const mesh::TriangleMesh read = viewer_export::read_mesh(path, &read_attributes);
+    EXPECT_EQ(read.vertices, two_triangles().vertices);
+    EXPECT_EQ(read.triangles, two_triangles().triangles);
+    EXPECT_EQ(read_attributes.colors, attributes.colors);
+    ASSERT_EQ(read_attributes.scalars.size(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+      EXPECT_EQ(read_attributes.scalars[k].name, attributes.scalars[k].name);
+      EXPECT_EQ(read_attributes.scalars[k].values, attributes.scalars[k].values) << ascii;
+    }
+  }
+}
+
 TEST(MeshWriter, PlyAndObjRoundTripThroughTheDispatcher) {
   const std::filesystem::path dir = scratch_dir("mesh_writer_round_trip");
   viewer_export::MeshAttributes attributes;

@@ -74,7 +74,7 @@ void write_mesh(const std::string& path, const mesh::TriangleMesh& mesh,
 
 mesh::TriangleMesh read_mesh(const std::string& path, MeshAttributes* attributes) {
   const std::string extension = mesh_extension(path);
-  if (extension == ".ply") return read_ply_mesh(path);
+  if (extension == ".ply") return read_ply_mesh(path, attributes);
   if (extension == ".obj") return read_obj_mesh(path, attributes);
   if (extension == ".glb" || extension == ".gltf") return read_mesh_with_assimp(path, attributes);
   throw MeshFileError(path + ": unknown mesh format '" + extension +
