@@ -26,5 +26,9 @@ Command register_simulate(CLI::App& app, const CliContext& context);
 Command register_bench(CLI::App& app, const CliContext& context);
 /// `featsense eval traj|mesh ...`: figures against ground truth (one command per subcommand).
 std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
+/// `featsense export MESH -o FILE`: a mesh in another format, chosen by the extension.
+Command register_export(CLI::App& app, const CliContext& context);
+/// `featsense navmesh MESH -o NAV`: traversability layers for mesh-based navigation.
+Command register_navmesh(CLI::App& app, const CliContext& context);
 
 }  // namespace featsense::app

@@ -46,7 +46,9 @@ int main(int argc, char** argv) {
   std::vector<featsense::app::Command> commands = {featsense::app::register_info(app, context),
                                                    featsense::app::register_convert(app, context),
                                                    featsense::app::register_simulate(app, context),
-                                                   featsense::app::register_bench(app, context)};
+                                                   featsense::app::register_bench(app, context),
+                                                   featsense::app::register_export(app, context),
+                                                   featsense::app::register_navmesh(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.

@@ -8,7 +8,8 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(spdlog CONFIG REQUIRED)
 find_package(nlohmann_json 3 CONFIG REQUIRED)
 find_package(BZip2 REQUIRED)
-# The global map store (storage/): serial HDF5's C API and zlib for the journal's records.
+# Serial HDF5's C API: the global map store (storage/) and the mesh navigation export
+# (viewer_export/src/mesh_nav_h5_writer.cpp); zlib for the store journal's records.
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(ZLIB REQUIRED)
 # OpenVDB (storage/src/vdb_io.cpp only): Debian installs its find module beside its CMake files.
@@ -17,7 +18,8 @@ find_package(OpenVDB REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
-# The simulator: Embree casts the rays, assimp reads scene meshes (both only in slam/src/sim).
+# The simulator: Embree casts the rays, assimp reads scene meshes (slam/src/sim); assimp also
+# reads glTF/OBJ meshes back in viewer_export.
 find_package(embree 3 CONFIG REQUIRED)
 find_package(assimp CONFIG REQUIRED)
 # CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings

@@ -2,9 +2,11 @@
 // order, keeping the vertex positions, normals and faces.
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "featsense/viewer_export/ply_mesh_io.hpp"
 
@@ -91,7 +93,7 @@ int find(const Element& element, const std::string& name) {
 
 }  // namespace
 
-mesh::TriangleMesh read_ply_mesh(const std::string& path) {
+mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attributes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw PlyError(path + ": cannot open");
   std::string line;
@@ -165,7 +167,19 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path) {
     int xyz[3] = {-1, -1, -1};
     int nxyz[3] = {-1, -1, -1};
     int indices = -1;
+    int rgb[3] = {-1, -1, -1};
+    std::vector<std::pair<size_t, size_t>> scalar_of_property;  // (property, layer)
+    MeshAttributes read_attributes;
     if (is_vertex) {
+      const char* color_names[3] = {"red", "green", "blue"};
+      for (int k = 0; k < 3; ++k) rgb[k] = find(element, color_names[k]);
+      for (size_t p = 0; p < element.properties.size(); ++p) {
+        const std::string& name = element.properties[p].name;
+        if (name.rfind("scalar_", 0) == 0 && element.properties[p].count_type.empty()) {
+          scalar_of_property.emplace_back(p, read_attributes.scalars.size());
+          read_attributes.scalars.push_back({name.substr(7), {}});
+        }
+      }
       has_vertices = true;
       const char* names[3] = {"x", "y", "z"};
       const char* normal_names[3] = {"nx", "ny", "nz"};
@@ -185,6 +199,7 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path) {
       }
     }
     const bool normals = nxyz[0] >= 0 && nxyz[1] >= 0 && nxyz[2] >= 0;
+    const bool colors = rgb[0] >= 0 && rgb[1] >= 0 && rgb[2] >= 0;
     std::vector<double> values(element.properties.size());
     std::vector<long long> polygon;
     for (size_t item = 0; item < element.count; ++item) {
@@ -221,8 +236,20 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path) {
                                     values[static_cast<size_t>(nxyz[1])],
                                     values[static_cast<size_t>(nxyz[2])]);
         }
+        if (colors) {
+          Eigen::Matrix<uint8_t, 3, 1> color;
+          for (int k = 0; k < 3; ++k) {
+            color[k] = static_cast<uint8_t>(
+                std::lround(std::clamp(values[static_cast<size_t>(rgb[k])], 0.0, 255.0)));
+          }
+          read_attributes.colors.push_back(color);
+        }
+        for (const auto& [p, layer] : scalar_of_property) {
+          read_attributes.scalars[layer].values.push_back(static_cast<float>(values[p]));
+        }
       }
     }
+    if (is_vertex && attributes != nullptr) *attributes = std::move(read_attributes);
   }
   if (!has_vertices) throw PlyError(path + ": no vertex element");
   try {

@@ -1,7 +1,8 @@
 #pragma once
 /// PLY meshes and point clouds (ascii, binary little- and big-endian).
 ///
-/// Reading: the `vertex` element's x, y, z (and nx, ny, nz where present) of any numeric type,
+/// Reading: the `vertex` element's x, y, z (and nx, ny, nz, red, green, blue, scalar_<name>
+/// where present) of any numeric type,
 /// and the `face` element's index list (`vertex_indices` or `vertex_index`, any count and index
 /// type; polygons are split into a fan of triangles). Other elements and properties are
 /// skipped. A file without faces reads as a point cloud (a mesh without triangles).
@@ -26,9 +27,6 @@ class PlyError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Reads a PLY mesh or point cloud; throws PlyError naming the file and what is wrong.
-mesh::TriangleMesh read_ply_mesh(const std::string& path);
-
 /// A per-vertex float layer, written as property `scalar_<name>`.
 struct VertexScalar {
   std::string name;
@@ -41,6 +39,11 @@ struct MeshAttributes {
   std::vector<VertexScalar> scalars;
   std::vector<Eigen::Matrix<uint8_t, 3, 1>> colors;  ///< per vertex RGB, or empty
 };
+
+/// Reads a PLY mesh or point cloud; throws PlyError naming the file and what is wrong. Where
+/// `attributes` is given, it receives the vertex colours (red, green, blue) and every
+/// `scalar_<name>` vertex property as layer `<name>`.
+mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attributes = nullptr);
 
 struct PlyWriteSettings {
   bool binary = true;  ///< binary little-endian; false: ascii
