@@ -3,6 +3,7 @@
 // and a skip for machines that do not have them.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
@@ -18,8 +19,10 @@ inline std::filesystem::path shared_data_dir() {
 
 /// A scratch folder for one test, emptied first.
 inline std::filesystem::path scratch_dir(const std::string& name) {
+  // Per process: ctest runs test programs, and the instances of a parameterised test, in
+  // parallel, and two of them must never empty each other's folder.
   const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "featsense-test" / name;
+      std::filesystem::temp_directory_path() / "featsense-test" / std::to_string(::getpid()) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
