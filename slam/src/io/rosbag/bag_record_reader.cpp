@@ -99,14 +99,9 @@ bool BagRecordReader::read_top_level(std::optional<BagMessage>& message) {
         return !finished_;
       case BagOp::kMessageData: {
         if (cut_off) break;
-        BagMessage found;
-        found.connection = header.u32("conn");
-        found.time_ns = header.time_ns("time");
-        found.offset = record_offset;
-        ++stats_.message_counts[found.connection];
-        const auto known = connections_.find(found.connection);
-        const BagConnection* connection = known == connections_.end() ? nullptr : &known->second;
-        if (options_.wanted && !options_.wanted(found, connection)) break;
+        std::optional<BagMessage> wanted = count_and_filter(header, record_offset);
+        if (!wanted) break;
+        BagMessage& found = *wanted;
         if (data_size > options_.max_chunk_bytes) {
           warn(at(record_offset) + ": message of " + std::to_string(data_size) +
                " bytes is larger than the limit; skipped");
@@ -241,14 +236,9 @@ std::optional<BagMessage> BagRecordReader::next_in_chunk() {
       const BagRecordHeader header = BagRecordHeader::parse({record + 4, header_size});
       switch (header.op()) {
         case BagOp::kMessageData: {
-          BagMessage message;
-          message.connection = header.u32("conn");
-          message.time_ns = header.time_ns("time");
-          message.offset = chunk_offset_;
-          ++stats_.message_counts[message.connection];
-          const auto known = connections_.find(message.connection);
-          const BagConnection* connection = known == connections_.end() ? nullptr : &known->second;
-          if (options_.wanted && !options_.wanted(message, connection)) break;
+          std::optional<BagMessage> wanted = count_and_filter(header, chunk_offset_);
+          if (!wanted) break;
+          BagMessage& message = *wanted;
           message.data = data;
           return message;
         }
@@ -309,6 +299,19 @@ void BagRecordReader::skip_to(uint64_t offset) {
 void BagRecordReader::warn(const std::string& message) {
   ++stats_.warnings;
   if (options_.warn) options_.warn(message);
+}
+
+std::optional<BagMessage> BagRecordReader::count_and_filter(const BagRecordHeader& header,
+                                                            uint64_t offset) {
+  BagMessage message;
+  message.connection = header.u32("conn");
+  message.time_ns = header.time_ns("time");
+  message.offset = offset;
+  ++stats_.message_counts[message.connection];
+  const auto known = connections_.find(message.connection);
+  const BagConnection* connection = known == connections_.end() ? nullptr : &known->second;
+  if (options_.wanted && !options_.wanted(message, connection)) return std::nullopt;
+  return message;
 }
 
 std::string BagRecordReader::at(uint64_t offset) const {

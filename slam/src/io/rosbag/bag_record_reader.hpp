@@ -101,6 +101,9 @@ class BagRecordReader {
   void skip_to(uint64_t offset);
   void warn(const std::string& message);
   std::string at(uint64_t offset) const;
+  /// A message record's header as a BagMessage (data not yet attached), counted per
+  /// connection; nullopt when the options' filter does not want it.
+  std::optional<BagMessage> count_and_filter(const BagRecordHeader& header, uint64_t offset);
 
   std::istream& stream_;
   std::string origin_;
