@@ -128,7 +128,8 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
   const TimingSummary t = summarize_ms(times_ms);
   const double points_per_scan =
       static_cast<double>(scans.input_points) / static_cast<double>(scans.rays.size());
-  const double voxels_median = min_median_max(updated)["median"].get<double>();
+  const nlohmann::json updated_summary = min_median_max(updated);
+  const double voxels_median = updated_summary["median"].get<double>();
   // The least memory traffic a scan needs: the points uploaded (end point and origin, 12 bytes
   // each) and, per updated voxel, the candidate written, read and reset and the voxel read and
   // written (5 x 4 bytes). Divided by the GPU's bandwidth it gives the floor of the time.
@@ -152,7 +153,7 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
       {"points_per_scan", points_per_scan},
       {"points_per_s", t.median_ms > 0.0 ? points_per_scan / (t.median_ms * 1e-3) : 0.0},
       {"rays_per_scan", min_median_max(rays)},
-      {"voxels_updated_per_scan", min_median_max(updated)},
+      {"voxels_updated_per_scan", updated_summary},
       {"min_bytes_per_scan", bytes_per_scan},
       {"memory_bytes", integrator->memory_bytes()}};
   return result;

@@ -1,5 +1,7 @@
 #include "json_output.hpp"
 
+#include "featsense/slam/trajectory/error_statistics.hpp"
+
 #include <algorithm>
 #include <fstream>
 #include <iostream>
@@ -20,12 +22,9 @@ void write_json(const nlohmann::json& document, const std::string& path) {
   if (!file) throw std::runtime_error(path + ": writing the JSON output failed (disk full?)");
 }
 
-nlohmann::json min_median_max(std::vector<double> values) {
-  if (values.empty()) return {{"min", 0}, {"median", 0}, {"max", 0}};
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  const double median = n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-  return {{"min", values.front()}, {"median", median}, {"max", values.back()}};
+nlohmann::json min_median_max(const std::vector<double>& values) {
+  const slam::ErrorStatistics statistics = slam::error_statistics(values);
+  return {{"min", statistics.min}, {"median", statistics.median}, {"max", statistics.max}};
 }
 
 }  // namespace featsense::app

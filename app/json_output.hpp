@@ -13,6 +13,6 @@ namespace featsense::app {
 void write_json(const nlohmann::json& document, const std::string& path);
 
 /// {"min", "median", "max"} of the values (all 0 when empty).
-nlohmann::json min_median_max(std::vector<double> values);
+nlohmann::json min_median_max(const std::vector<double>& values);
 
 }  // namespace featsense::app

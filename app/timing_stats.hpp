@@ -2,8 +2,7 @@
 // Per-stage timings in milliseconds and their summary (median / p95 / max), as every
 // report and benchmark prints them.
 
-#include <nlohmann/json.hpp>
-
+#include <cstddef>
 #include <vector>
 
 namespace featsense::app {
@@ -18,6 +17,5 @@ struct TimingSummary {
 
 /// Summary of samples in milliseconds (p95 by the nearest-rank method).
 TimingSummary summarize_ms(std::vector<double> samples_ms);
-nlohmann::json to_json(const TimingSummary& summary);
 
 }  // namespace featsense::app
