@@ -4,10 +4,12 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "brick_checks.hpp"
 #include "cuda_check.hpp"
 #include "device_buffer.hpp"
 #include "featsense/tsdf/integrator.hpp"
@@ -106,6 +108,20 @@ __global__ void fuse_bricks_kernel(const uint32_t* touched_bricks, const uint32_
   }
 }
 
+/// One block per brick, one thread per voxel: copies whole bricks between the map (at
+/// their storage offsets) and a dense staging array (brick after brick).
+__global__ void gather_bricks_kernel(const uint32_t* map, const uint64_t* offsets,
+                                     uint32_t* staging) {
+  staging[static_cast<size_t>(blockIdx.x) * kBrickVoxels + threadIdx.x] =
+      map[offsets[blockIdx.x] + threadIdx.x];
+}
+
+__global__ void scatter_bricks_kernel(const uint32_t* staging, const uint64_t* offsets,
+                                      uint32_t* map) {
+  map[offsets[blockIdx.x] + threadIdx.x] =
+      staging[static_cast<size_t>(blockIdx.x) * kBrickVoxels + threadIdx.x];
+}
+
 class CudaIntegrator final : public Integrator {
  public:
   CudaIntegrator(const TsdfSettings& settings, Vec3 centre_m)
@@ -138,7 +154,8 @@ class CudaIntegrator final : public Integrator {
   const LocalMapGeometry& geometry() const override { return geometry_; }
   size_t memory_bytes() const override {
     return map_.bytes() + candidates_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
-           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes();
+           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
+           brick_offsets_.bytes() + brick_staging_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -147,6 +164,39 @@ class CudaIntegrator final : public Integrator {
                                          cudaMemcpyDeviceToHost, stream_));
     FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
     return out;
+  }
+
+  void read_bricks(const std::vector<Index3>& bricks,
+                   std::vector<uint32_t>& voxels) const override {
+    voxels.resize(bricks.size() * kBrickVoxels);
+    for_each_brick_batch(bricks, [&](size_t first, size_t count) {
+      gather_bricks_kernel<<<static_cast<unsigned int>(count), kBrickVoxels, 0, stream_>>>(
+          map_.data(), brick_offsets_.data(), brick_staging_.data());
+      FEATSENSE_CUDA_CHECK(cudaGetLastError());
+      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(
+          voxels.data() + first * kBrickVoxels, brick_staging_.data(),
+          count * kBrickVoxels * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream_));
+      FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    });
+  }
+
+  void write_bricks(const std::vector<Index3>& bricks,
+                    const std::vector<uint32_t>& voxels) override {
+    check_brick_voxels(bricks, voxels);
+    for_each_brick_batch(bricks, [&](size_t first, size_t count) {
+      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(
+          brick_staging_.data(), voxels.data() + first * kBrickVoxels,
+          count * kBrickVoxels * sizeof(uint32_t), cudaMemcpyHostToDevice, stream_));
+      scatter_bricks_kernel<<<static_cast<unsigned int>(count), kBrickVoxels, 0, stream_>>>(
+          brick_staging_.data(), brick_offsets_.data(), map_.data());
+      FEATSENSE_CUDA_CHECK(cudaGetLastError());
+      FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    });
+  }
+
+  void set_origin(Index3 origin) override {
+    check_brick_aligned(origin);
+    geometry_.origin = origin;
   }
 
   IntegrationStats integrate(const RayBatch& rays) override {
@@ -216,6 +266,27 @@ class CudaIntegrator final : public Integrator {
 
   void fill_identity(uint32_t n, uint32_t* kept_count);
 
+  /// Runs copy(first, count) over batches of `bricks` with the batch's storage offsets in
+  /// brick_offsets_: batches bound the staging memory that moving the map takes on the device.
+  template <typename Copy>
+  void for_each_brick_batch(const std::vector<Index3>& bricks, const Copy& copy) const {
+    constexpr size_t kBatchBricks = 16384;  // 32 MB of voxels
+    for (const Index3& brick : bricks) check_brick_inside(geometry_, brick);
+    for (size_t first = 0; first < bricks.size(); first += kBatchBricks) {
+      const size_t count = std::min(kBatchBricks, bricks.size() - first);
+      host_offsets_.resize(count);
+      for (size_t k = 0; k < count; ++k) {
+        host_offsets_[k] = geometry_.brick_offset(bricks[first + k]);
+      }
+      brick_offsets_.reserve(count);
+      brick_staging_.reserve(count * kBrickVoxels);
+      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(brick_offsets_.data(), host_offsets_.data(),
+                                           count * sizeof(uint64_t), cudaMemcpyHostToDevice,
+                                           stream_));
+      copy(first, count);
+    }
+  }
+
   TsdfSettings settings_;
   LocalMapGeometry geometry_;
   cudaStream_t stream_ = nullptr;
@@ -230,6 +301,10 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<Vec3> endpoints_;
   cuda::DeviceBuffer<Vec3> origins_;
   cuda::PinnedBuffer<Vec3> staging_;
+  // Moving the map: the storage offsets of a batch of bricks and their voxels.
+  mutable std::vector<uint64_t> host_offsets_;
+  mutable cuda::DeviceBuffer<uint64_t> brick_offsets_;
+  mutable cuda::DeviceBuffer<uint32_t> brick_staging_;
 };
 
 __global__ void identity_kernel(uint32_t* kept, uint32_t n, uint32_t* kept_count) {

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <memory>
 
+#include "brick_checks.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "ray_marcher.hpp"
 
@@ -47,6 +48,29 @@ class CpuIntegrator final : public Integrator {
     return geometry_.voxel_count() * 2 * sizeof(uint32_t) + geometry_.voxel_count() / kBrickVoxels;
   }
 
+  void read_bricks(const std::vector<Index3>& bricks,
+                   std::vector<uint32_t>& voxels) const override {
+    voxels.resize(bricks.size() * kBrickVoxels);
+    for_each_brick(bricks, [&](size_t k, size_t offset) {
+      std::copy_n(map_.begin() + static_cast<std::ptrdiff_t>(offset), kBrickVoxels,
+                  voxels.begin() + static_cast<std::ptrdiff_t>(k * kBrickVoxels));
+    });
+  }
+
+  void write_bricks(const std::vector<Index3>& bricks,
+                    const std::vector<uint32_t>& voxels) override {
+    check_brick_voxels(bricks, voxels);
+    for_each_brick(bricks, [&](size_t k, size_t offset) {
+      std::copy_n(voxels.begin() + static_cast<std::ptrdiff_t>(k * kBrickVoxels), kBrickVoxels,
+                  map_.begin() + static_cast<std::ptrdiff_t>(offset));
+    });
+  }
+
+  void set_origin(Index3 origin) override {
+    check_brick_aligned(origin);
+    geometry_.origin = origin;
+  }
+
   IntegrationStats integrate(const RayBatch& rays) override {
     check_ray_batch(rays);
     const std::vector<uint32_t> kept = rays_to_march(rays);
@@ -83,6 +107,18 @@ class CpuIntegrator final : public Integrator {
   }
 
  private:
+  /// Calls visit(k, storage offset of bricks[k]) for every brick, in parallel.
+  template <typename Visit>
+  void for_each_brick(const std::vector<Index3>& bricks, const Visit& visit) const {
+    for (const Index3& brick : bricks) check_brick_inside(geometry_, brick);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, bricks.size(), 256),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                        for (size_t k = range.begin(); k != range.end(); ++k) {
+                          visit(k, geometry_.brick_offset(bricks[k]));
+                        }
+                      });
+  }
+
   /// Indices of the rays to march: all, or the first end point of each voxel of the local
   /// map plus every end point outside it (the rule of TsdfSettings::reduce_points_per_voxel,
   /// computed as the CUDA backend does: a minimum of point indices per voxel).

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "featsense/tsdf/local_map_shift.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
 namespace featsense::tsdf {
@@ -43,11 +44,7 @@ LocalMapGeometry centred_geometry(const TsdfSettings& settings, Vec3 centre_m) {
   LocalMapGeometry g;
   g.voxel_size_m = settings.voxel_size_m;
   g.dim = settings.map_dim();
-  const Index3 centre = g.voxel_of(centre_m);
-  const Index3 nb = g.bricks();
-  g.origin = {(brick_of(centre.x) - (nb.x - 1) / 2) * kBrickSize,
-              (brick_of(centre.y) - (nb.y - 1) / 2) * kBrickSize,
-              (brick_of(centre.z) - (nb.z - 1) / 2) * kBrickSize};
+  g.origin = centred_origin(g, centre_m);
   return g;
 }
 

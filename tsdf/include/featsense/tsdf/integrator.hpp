@@ -32,6 +32,22 @@ class Integrator {
   virtual std::vector<uint32_t> download() const = 0;
   /// Bytes of memory the two volumes take (device memory for the CUDA backend).
   virtual size_t memory_bytes() const = 0;
+
+  // Brick access for moving the map (local_map_shift.hpp). A brick is named by its global
+  // brick coordinate (global voxel index / kBrickSize) and must lie inside the local map; its
+  // kBrickVoxels packed voxels are in brick order, (z * 8 + y) * 8 + x.
+
+  /// Copies the listed bricks into `voxels` (resized to bricks.size() * kBrickVoxels).
+  virtual void read_bricks(const std::vector<Index3>& bricks,
+                           std::vector<uint32_t>& voxels) const = 0;
+  /// Overwrites the listed bricks with `voxels` (bricks.size() * kBrickVoxels of them).
+  virtual void write_bricks(const std::vector<Index3>& bricks,
+                            const std::vector<uint32_t>& voxels) = 0;
+  /// Moves the local map's lowest corner to `origin` (a multiple of kBrickSize) without
+  /// touching any voxel: the bricks the old and the new box share keep their voxels, and the
+  /// ring-buffer slots of the bricks that left now hold stale voxels for the bricks that
+  /// entered. Use shift_local_map(), which fills them.
+  virtual void set_origin(Index3 origin) = 0;
 };
 
 /// The CPU reference integrator (TBB).

@@ -86,6 +86,18 @@ struct LocalMapGeometry {
             (static_cast<float>(g.y) + 0.5f) * voxel_size_m,
             (static_cast<float>(g.z) + 0.5f) * voxel_size_m};
   }
+  /// The global voxel index of brick b's lowest corner voxel.
+  FEATSENSE_HD_INLINE static Index3 first_voxel_of_brick(Index3 b) {
+    return {b.x * kBrickSize, b.y * kBrickSize, b.z * kBrickSize};
+  }
+  FEATSENSE_HD_INLINE bool contains_brick(Index3 b) const {
+    return contains(first_voxel_of_brick(b));
+  }
+  /// Storage position of the first voxel of brick b (which must be contained); the brick's
+  /// kBrickVoxels voxels follow it in brick order.
+  FEATSENSE_HD_INLINE size_t brick_offset(Index3 b) const {
+    return linear(first_voxel_of_brick(b));
+  }
   /// The voxel of map-frame point p when p lies inside the local map; false for points
   /// outside it and for NaN. Points from outside must be checked in metres first: voxel
   /// indices are 32-bit, and a far-away point would overflow them.

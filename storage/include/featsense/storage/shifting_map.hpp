@@ -1,0 +1,69 @@
+#pragma once
+/// The local map and the global store together: the local map follows the sensor, the
+/// bricks it leaves are spilled into the store's chunks and the bricks it enters are loaded
+/// from them, so that the store plus the local map always hold the whole map. sync() writes
+/// the local map into the store too, after which the store alone holds it.
+///
+/// The store keeps no partial truth: a chunk that the local map only partly covers is read,
+/// its covered bricks replaced, and written back whole.
+
+#include <cstdint>
+#include <set>
+#include <unordered_map>
+#include <vector>
+
+#include "featsense/storage/chunk_store.hpp"
+#include "featsense/tsdf/integrator.hpp"
+#include "featsense/tsdf/local_map_shift.hpp"
+
+namespace featsense::storage {
+
+struct ShiftingMapStats {
+  size_t shifts = 0;
+  size_t bricks_spilled = 0;
+  size_t bricks_loaded = 0;
+  size_t chunks_written = 0;    ///< chunks written to the store (spills and syncs)
+  size_t chunks_unchanged = 0;  ///< chunks not written because the store already held them
+  size_t syncs = 0;
+};
+
+class ShiftingMap {
+ public:
+  /// Takes `map` and `store` by reference (both must outlive this) and loads the local map's
+  /// region from the store: a map continued from an existing store starts where it left off.
+  /// The store's voxel size must be the map's.
+  ShiftingMap(tsdf::Integrator& map, ChunkStore& store, double shift_threshold_m);
+
+  /// Moves the local map onto the sensor when the sensor is more than the shift threshold
+  /// from the map's centre. Returns true when it moved.
+  bool follow(tsdf::Vec3 sensor_m);
+  /// Moves the local map so that its lowest corner is `origin` (whole bricks).
+  void move_to(tsdf::Index3 origin);
+  /// Writes the local map's observed chunks into the store (unchanged ones are skipped) and
+  /// flushes the store: afterwards the store alone holds the whole map, durably.
+  void sync();
+
+  /// The centre of the local map, map frame, metres.
+  tsdf::Vec3 centre_m() const;
+  const ShiftingMapStats& stats() const { return stats_; }
+  tsdf::Integrator& integrator() { return map_; }
+
+ private:
+  /// Voxels of bricks[k] start at voxels_of(k).
+  template <typename VoxelsOf>
+  void spill(const std::vector<tsdf::Index3>& bricks, const VoxelsOf& voxels_of);
+  void load(const std::vector<tsdf::Index3>& bricks, std::vector<uint32_t>& voxels);
+  bool unchanged_in_store(const ChunkKey& key, uint64_t digest) const;
+
+  tsdf::Integrator& map_;
+  ChunkStore& store_;
+  double shift_threshold_m_;
+  std::set<ChunkKey> keys_at_open_;                               ///< digests unknown
+  std::unordered_map<ChunkKey, uint64_t, ChunkKeyHash> written_;  ///< digest of the last write
+  ShiftingMapStats stats_;
+};
+
+/// A 64-bit digest of a chunk's voxels, to tell whether a chunk changed since it was written.
+uint64_t chunk_digest(const Chunk& chunk);
+
+}  // namespace featsense::storage

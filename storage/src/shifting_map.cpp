@@ -1,0 +1,179 @@
+#include "featsense/storage/shifting_map.hpp"
+
+#include "featsense/tsdf/voxel.hpp"
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace featsense::storage {
+namespace {
+
+using tsdf::Index3;
+using tsdf::kBrickSize;
+using tsdf::kBrickVoxels;
+
+constexpr int32_t kBricksPerChunk = kChunkSize / kBrickSize;  // per axis
+constexpr size_t kBricksInChunk =
+    static_cast<size_t>(kBricksPerChunk) * kBricksPerChunk * kBricksPerChunk;
+
+ChunkKey chunk_of_brick(Index3 brick) {
+  return chunk_of_voxel(static_cast<int64_t>(brick.x) * kBrickSize,
+                        static_cast<int64_t>(brick.y) * kBrickSize,
+                        static_cast<int64_t>(brick.z) * kBrickSize);
+}
+
+/// The lowest voxel of `brick` in chunk-local coordinates (0..63).
+Index3 brick_corner_in_chunk(Index3 brick, const ChunkKey& key) {
+  return {brick.x * kBrickSize - key.x * kChunkSize, brick.y * kBrickSize - key.y * kChunkSize,
+          brick.z * kBrickSize - key.z * kChunkSize};
+}
+
+/// The indices into `bricks` grouped by the chunk that holds each brick, chunks in key order
+/// (so that the store is written in a reproducible order).
+std::map<ChunkKey, std::vector<size_t>> group_by_chunk(const std::vector<Index3>& bricks) {
+  std::map<ChunkKey, std::vector<size_t>> groups;
+  for (size_t k = 0; k < bricks.size(); ++k) groups[chunk_of_brick(bricks[k])].push_back(k);
+  return groups;
+}
+
+/// Brick order ((z * 8 + y) * 8 + x) into the chunk's x-fastest rows, and back.
+void copy_brick_into_chunk(const uint32_t* brick_voxels, Index3 corner, Chunk& chunk) {
+  for (int32_t z = 0; z < kBrickSize; ++z) {
+    for (int32_t y = 0; y < kBrickSize; ++y) {
+      const uint32_t* row = brick_voxels + (z * kBrickSize + y) * kBrickSize;
+      std::copy_n(row, kBrickSize, &chunk.at(corner.x, corner.y + y, corner.z + z));
+    }
+  }
+}
+
+void copy_brick_from_chunk(const Chunk& chunk, Index3 corner, uint32_t* brick_voxels) {
+  for (int32_t z = 0; z < kBrickSize; ++z) {
+    for (int32_t y = 0; y < kBrickSize; ++y) {
+      const uint32_t* row =
+          chunk.voxels.data() + Chunk::index(corner.x, corner.y + y, corner.z + z);
+      std::copy_n(row, kBrickSize, brick_voxels + (z * kBrickSize + y) * kBrickSize);
+    }
+  }
+}
+
+}  // namespace
+
+uint64_t chunk_digest(const Chunk& chunk) {
+  // Two voxels per step, multiply-rotate mixing: fast, and a changed voxel changes the
+  // digest except with probability 2^-64.
+  uint64_t h = 0x9E3779B97F4A7C15ull;
+  const size_t n = chunk.voxels.size();
+  for (size_t i = 0; i + 1 < n; i += 2) {
+    const uint64_t word =
+        static_cast<uint64_t>(chunk.voxels[i]) | (static_cast<uint64_t>(chunk.voxels[i + 1]) << 32);
+    h = (h ^ word) * 0xFF51AFD7ED558CCDull;
+    h = (h << 29) | (h >> 35);
+  }
+  return h ^ (h >> 31);
+}
+
+ShiftingMap::ShiftingMap(tsdf::Integrator& map, ChunkStore& store, double shift_threshold_m)
+    : map_(map), store_(store), shift_threshold_m_(shift_threshold_m) {
+  const double map_voxel = map_.geometry().voxel_size_m;
+  const double store_voxel = store_.metadata().voxel_size_m;
+  if (std::abs(map_voxel - store_voxel) > 1e-6 * store_voxel) {
+    throw std::invalid_argument("the local map's voxel size " + std::to_string(map_voxel) +
+                                " m differs from the store's " + std::to_string(store_voxel) +
+                                " m");
+  }
+  for (const ChunkKey& key : store_.keys()) keys_at_open_.insert(key);
+  if (!keys_at_open_.empty()) {
+    const std::vector<Index3> bricks = tsdf::bricks_of(map_.geometry());
+    std::vector<uint32_t> voxels;
+    load(bricks, voxels);
+    map_.write_bricks(bricks, voxels);
+    stats_.bricks_loaded += bricks.size();
+  }
+}
+
+tsdf::Vec3 ShiftingMap::centre_m() const {
+  const tsdf::LocalMapGeometry& g = map_.geometry();
+  const tsdf::Vec3 lo = g.min_corner();
+  const tsdf::Vec3 hi = g.max_corner();
+  return 0.5f * (lo + hi);
+}
+
+bool ShiftingMap::follow(tsdf::Vec3 sensor_m) {
+  if (tsdf::norm(sensor_m - centre_m()) <= shift_threshold_m_) return false;
+  const Index3 origin = tsdf::centred_origin(map_.geometry(), sensor_m);
+  const Index3 now = map_.geometry().origin;
+  if (origin.x == now.x && origin.y == now.y && origin.z == now.z) return false;
+  move_to(origin);
+  return true;
+}
+
+void ShiftingMap::move_to(Index3 origin) {
+  const tsdf::ShiftStats shift = tsdf::shift_local_map(
+      map_, origin,
+      [this](const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
+        load(bricks, voxels);
+      },
+      [this](const std::vector<Index3>& bricks, const std::vector<uint32_t>& voxels) {
+        spill(bricks, [&](size_t k) { return voxels.data() + k * kBrickVoxels; });
+      });
+  if (shift.bricks_left == 0) return;
+  ++stats_.shifts;
+  stats_.bricks_spilled += shift.bricks_left;
+  stats_.bricks_loaded += shift.bricks_entered;
+}
+
+void ShiftingMap::sync() {
+  const std::vector<uint32_t> all = map_.download();
+  const tsdf::LocalMapGeometry& geometry = map_.geometry();
+  const std::vector<Index3> bricks = tsdf::bricks_of(geometry);
+  spill(bricks, [&](size_t k) { return all.data() + geometry.brick_offset(bricks[k]); });
+  store_.flush();
+  ++stats_.syncs;
+}
+
+template <typename VoxelsOf>
+void ShiftingMap::spill(const std::vector<Index3>& bricks, const VoxelsOf& voxels_of) {
+  for (const auto& [key, members] : group_by_chunk(bricks)) {
+    Chunk chunk;
+    // A chunk the bricks cover whole needs nothing from the store.
+    if (members.size() < kBricksInChunk) {
+      if (std::optional<Chunk> stored = store_.read(key)) chunk = std::move(*stored);
+    }
+    for (const size_t k : members) {
+      copy_brick_into_chunk(voxels_of(k), brick_corner_in_chunk(bricks[k], key), chunk);
+    }
+    const uint64_t digest = chunk_digest(chunk);
+    if (unchanged_in_store(key, digest)) {
+      ++stats_.chunks_unchanged;
+      continue;
+    }
+    store_.write(key, chunk);
+    written_[key] = digest;
+    ++stats_.chunks_written;
+  }
+}
+
+bool ShiftingMap::unchanged_in_store(const ChunkKey& key, uint64_t digest) const {
+  const auto found = written_.find(key);
+  if (found != written_.end()) return found->second == digest;
+  // Never written by this map: the store holds nothing there unless it did at open (whose
+  // contents are unknown here), and nothing is what an empty chunk means.
+  static const uint64_t kEmptyDigest = chunk_digest(Chunk{});
+  return keys_at_open_.count(key) == 0 && digest == kEmptyDigest;
+}
+
+void ShiftingMap::load(const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
+  voxels.assign(bricks.size() * kBrickVoxels, tsdf::kUnobservedVoxel);
+  for (const auto& [key, members] : group_by_chunk(bricks)) {
+    const std::optional<Chunk> chunk = store_.read(key);
+    if (!chunk) continue;
+    for (const size_t k : members) {
+      copy_brick_from_chunk(*chunk, brick_corner_in_chunk(bricks[k], key),
+                            voxels.data() + k * kBrickVoxels);
+    }
+  }
+}
+
+}  // namespace featsense::storage
