@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   std::vector<featsense::app::Command> commands = {featsense::app::register_info(app, context),
                                                    featsense::app::register_convert(app, context),
                                                    featsense::app::register_simulate(app, context),
+                                                   featsense::app::register_map(app, context),
                                                    featsense::app::register_bench(app, context),
                                                    featsense::app::register_export(app, context),
                                                    featsense::app::register_navmesh(app, context)};

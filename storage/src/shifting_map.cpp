@@ -2,6 +2,7 @@
 
 #include "featsense/tsdf/voxel.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -135,7 +136,19 @@ void ShiftingMap::sync() {
 
 template <typename VoxelsOf>
 void ShiftingMap::spill(const std::vector<Index3>& bricks, const VoxelsOf& voxels_of) {
+  static const uint64_t kEmptyDigest = chunk_digest(Chunk{});
   for (const auto& [key, members] : group_by_chunk(bricks)) {
+    // Most of a local map is never observed: a whole chunk of such bricks where the store
+    // holds nothing needs neither assembling nor writing.
+    if (members.size() == kBricksInChunk && unchanged_in_store(key, kEmptyDigest) &&
+        std::all_of(members.begin(), members.end(), [&](size_t k) {
+          const uint32_t* voxels = voxels_of(k);
+          return std::all_of(voxels, voxels + kBrickVoxels,
+                             [](uint32_t v) { return tsdf::unpack(v).weight == 0; });
+        })) {
+      ++stats_.chunks_unchanged;
+      continue;
+    }
     Chunk chunk;
     // A chunk the bricks cover whole needs nothing from the store.
     if (members.size() < kBricksInChunk) {

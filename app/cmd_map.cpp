@@ -1,0 +1,236 @@
+// featsense map INPUT -o OUT --gt TRAJ: a recording and its poses in; the map (map.h5), the
+// poses used (trajectory.tum / .kitti) and report.json out.
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "featsense/config/config_error.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/tsdf/integrator.hpp"
+#include "json_output.hpp"
+#include "map_pipeline.hpp"
+#include "map_report.hpp"
+#include "map_store.hpp"
+#include "source_options.hpp"
+#include "stop_signal.hpp"
+
+namespace featsense::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct MapOptions {
+  InputOptions input;
+  std::string output;
+  std::optional<std::string> gt;
+  std::string gt_format = "auto";
+  std::optional<std::string> gt_times;
+  std::optional<std::string> backend;
+  std::optional<std::string> continue_from;
+  std::optional<std::string> start;
+  std::optional<std::string> end;
+  bool overwrite = false;
+};
+
+/// "tum" when the first data line has 8 numbers, "kitti" for 12.
+std::string detect_trajectory_format(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw slam::TrajectoryError("cannot open trajectory " + path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    size_t count = 0;
+    for (std::string field; fields >> field;) ++count;
+    if (count == 0) continue;
+    if (count == 8) return "tum";
+    if (count == 12) return "kitti";
+    throw slam::TrajectoryError(path + ": a line of " + std::to_string(count) +
+                                " numbers is neither TUM (8) nor KITTI (12); see --gt-format");
+  }
+  throw slam::TrajectoryError(path + " holds no pose");
+}
+
+/// --start / --end: a frame index ("120") or seconds after the first scan ("12.5s").
+void parse_range_end(const std::string& text, const char* option, std::optional<uint64_t>& frame,
+                     std::optional<double>& seconds) {
+  std::istringstream in(text);
+  double value = 0.0;
+  if (!(in >> value) || value < 0.0) {
+    throw config::ConfigError(std::string(option) + ": expected a frame index or seconds like " +
+                              "12.5s, got '" + text + "'");
+  }
+  std::string unit;
+  in >> unit;
+  if (unit == "s") {
+    seconds = value;
+  } else if (unit.empty() && value == static_cast<double>(static_cast<uint64_t>(value))) {
+    frame = static_cast<uint64_t>(value);
+  } else {
+    throw config::ConfigError(std::string(option) + ": expected a frame index or seconds like " +
+                              "12.5s, got '" + text + "'");
+  }
+}
+
+FrameRange frame_range(const MapOptions& options) {
+  FrameRange range;
+  if (options.start) parse_range_end(*options.start, "--start", range.first_frame, range.first_s);
+  if (options.end) parse_range_end(*options.end, "--end", range.last_frame, range.last_s);
+  return range;
+}
+
+slam::Trajectory read_poses(const MapOptions& options) {
+  const std::string format =
+      options.gt_format == "auto" ? detect_trajectory_format(*options.gt) : options.gt_format;
+  if (options.gt_times && format != "kitti") {
+    throw config::ConfigError("--gt-times goes with KITTI poses");
+  }
+  return format == "kitti" ? slam::read_kitti(*options.gt, options.gt_times)
+                           : slam::read_tum(*options.gt);
+}
+
+tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d t = pose.translation();
+  return {static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())};
+}
+
+void run_map(const MapOptions& options, const CliContext& context) {
+  config::Config config = context.load_config();
+  if (options.backend) {
+    config.map.backend = *options.backend == "cuda"  ? config::Backend::kCuda
+                         : *options.backend == "cpu" ? config::Backend::kCpu
+                                                     : config::Backend::kAuto;
+  }
+  if (!options.gt) {
+    throw config::ConfigError(
+        "featsense map needs the sensor's poses: pass --gt TRAJ (a TUM file, or KITTI poses with "
+        "one pose per scan); this version has no odometry front end to estimate them");
+  }
+  const FrameRange range = frame_range(options);
+  std::unique_ptr<slam::ScanSource> source = options.input.open(config);
+  const slam::SourceInfo& info = source->info();
+  std::unique_ptr<ScanLocator> locator =
+      make_given_pose_locator(read_poses(options), config.odometry.deskew);
+
+  const fs::path out(options.output);
+  fs::create_directories(out);
+  MapStore map_store = open_map_store(out / "map.h5", config, info.sensor.name,
+                                      options.continue_from, options.overwrite);
+  storage::Hdf5ChunkStore& store = *map_store.store;
+  const tsdf::TsdfSettings settings = tsdf::TsdfSettings::from_config(config.map, info.sensor);
+
+  std::unique_ptr<tsdf::Integrator> integrator;
+  std::unique_ptr<storage::ShiftingMap> map;
+  std::string backend_reason;
+  const MapOpener open_map = [&](const LocatedScan& first) -> storage::ShiftingMap& {
+    integrator = tsdf::make_integrator(config.map.backend, settings,
+                                       position_of(first.T_map_sensor), &backend_reason);
+    spdlog::info("TSDF: {}", backend_reason);
+    map = std::make_unique<storage::ShiftingMap>(*integrator, store, config.map.shift_threshold_m);
+    return *map;
+  };
+
+  PipelineSettings pipeline;
+  pipeline.flush_interval_s = config.map.flush_interval_s;
+  pipeline.range = range;
+  pipeline.total_frames = info.frames;
+  pipeline.quiet = context.quiet;
+  spdlog::info("mapping {} ({}) with {}", info.path, info.format, locator->description());
+
+  PipelineResult result;
+  MapRunSummary summary;
+  {
+    const StopSignal stop_signal;
+    try {
+      result = run_map_pipeline(*source, *locator, open_map, pipeline);
+    } catch (...) {
+      // Whatever was integrated goes to disk before the error is reported.
+      try {
+        if (map) map->sync();
+        store.close();
+      } catch (const std::exception& e) {
+        spdlog::error("could not write the map after the failure: {}", e.what());
+      }
+      throw;
+    }
+    if (map) {
+      const auto start = std::chrono::steady_clock::now();
+      map->sync();
+      summary.final_flush_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
+    }
+    slam::Trajectory all_poses = map_store.earlier_poses;
+    for (size_t i = 0; i < result.poses.size(); ++i) {
+      all_poses.push_back(result.poses.stamps_ns[i], result.poses.poses[i]);
+    }
+    store.write_trajectory(to_store_poses(all_poses));
+    summary.map_chunks = store.keys().size();
+    store.close();
+  }
+  slam::write_tum(result.poses, (out / "trajectory.tum").string());
+  slam::write_kitti(result.poses, (out / "trajectory.kitti").string());
+
+  summary.config = &config;
+  summary.input = &info;
+  summary.backend = integrator ? integrator->backend_name() : "none";
+  summary.backend_reason = backend_reason;
+  summary.poses = locator->description();
+  summary.pipeline = &result;
+  if (map) summary.map = map->stats();
+  summary.continued_chunks = map_store.continued_chunks;
+  if (integrator && integrator->backend_name() == "cuda") {
+    summary.device_memory_bytes = integrator->memory_bytes();
+  }
+  write_json(map_report_json(summary), (out / "report.json").string());
+
+  if (result.frames_mapped == 0) {
+    throw std::runtime_error("no scan was mapped" + (result.warnings.empty()
+                                                         ? std::string()
+                                                         : ": " + result.warnings.front()));
+  }
+  if (!context.quiet) {
+    std::printf("%s%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
+                result.interrupted ? "interrupted: " : "", result.frames_mapped, result.wall_s,
+                result.wall_s > 0 ? static_cast<double>(result.frames_mapped) / result.wall_s : 0.0,
+                summary.backend.c_str(), summary.map_chunks, summary.map.shifts,
+                out.string().c_str());
+  }
+}
+
+}  // namespace
+
+Command register_map(CLI::App& app, const CliContext& context) {
+  auto options = std::make_shared<MapOptions>();
+  CLI::App* command = app.add_subcommand(
+      "map",
+      "Map a recording with given poses: the TSDF map (map.h5), the poses used and a report");
+  options->input.add_to(*command, false);
+  command->add_option("-o,--output", options->output, "Output folder")->required();
+  command->add_option("--gt", options->gt,
+                      "The sensor's poses: TUM (interpolated to each scan's and column's time) or "
+                      "KITTI (one pose per scan)");
+  command->add_option("--gt-format", options->gt_format, "Format of --gt: auto, tum or kitti")
+      ->check(CLI::IsMember({"auto", "tum", "kitti"}));
+  command->add_option("--gt-times", options->gt_times, "Times file of KITTI poses (times.txt)")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--backend", options->backend, "TSDF backend (map.backend): auto, cuda or cpu")
+      ->check(CLI::IsMember({"auto", "cuda", "cpu"}));
+  command->add_option("--continue", options->continue_from,
+                      "Continue an existing map (.h5 or .vdb): its voxel size and tau are kept");
+  command->add_option("--start", options->start,
+                      "First scan to map: a frame index, or seconds after the first scan (12.5s)");
+  command->add_option("--end", options->end, "Last scan to map (as --start)");
+  command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
+  return {command, [options, &context] { run_map(*options, context); }};
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,203 @@
+#include "map_pipeline.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "bounded_queue.hpp"
+#include "progress.hpp"
+#include "stop_signal.hpp"
+
+namespace featsense::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// What the three stages share: the first error, the warnings, the stop flag.
+class PipelineState {
+ public:
+  bool stopping() const { return failed_.load() || StopSignal::requested(); }
+
+  void fail(std::exception_ptr error) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!error_) error_ = error;
+    failed_.store(true);
+  }
+  void rethrow_failure() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+  void warn(const std::string& message, PipelineResult& result) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++result.warning_count;
+    if (result.warnings.size() < slam::ReadStats::kMaxKeptWarnings) {
+      result.warnings.push_back(message);
+      spdlog::warn("{}", message);
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::atomic<bool> failed_{false};
+  std::exception_ptr error_;
+};
+
+bool before_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
+  if (range.first_frame && scan.sequence < *range.first_frame) return true;
+  return range.first_s &&
+         static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 < *range.first_s;
+}
+
+bool after_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
+  if (range.last_frame && scan.sequence > *range.last_frame) return true;
+  return range.last_s && static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 > *range.last_s;
+}
+
+void read_scans(slam::ScanSource& source, const FrameRange& range, BoundedQueue<slam::Scan>& out,
+                PipelineState& state, PipelineResult& result) {
+  std::optional<int64_t> first_stamp_ns;
+  while (!state.stopping()) {
+    const Clock::time_point start = Clock::now();
+    std::optional<slam::Scan> scan = source.next();
+    if (!scan) break;
+    ++result.frames_read;
+    if (!first_stamp_ns) first_stamp_ns = scan->stamp_ns;
+    if (after_range(*scan, range, *first_stamp_ns)) break;
+    if (before_range(*scan, range, *first_stamp_ns)) {
+      ++result.frames_outside_range;
+      continue;
+    }
+    result.timings.read_ms.push_back(ms_since(start));
+    if (!out.push(std::move(*scan))) break;
+  }
+}
+
+void locate_scans(ScanLocator& locator, BoundedQueue<slam::Scan>& in,
+                  BoundedQueue<LocatedScan>& out, PipelineState& state, PipelineResult& result) {
+  while (std::optional<slam::Scan> scan = in.pop()) {
+    const Clock::time_point start = Clock::now();
+    std::string why;
+    std::optional<LocatedScan> located = locator.locate(*scan, why);
+    if (!located) {
+      ++result.frames_without_pose;
+      state.warn("skipped: " + why, result);
+      continue;
+    }
+    result.timings.locate_ms.push_back(ms_since(start));
+    if (!out.push(std::move(*located))) break;
+  }
+}
+
+class MappingStage {
+ public:
+  MappingStage(const MapOpener& open_map, const PipelineSettings& settings, PipelineResult& result)
+      : open_map_(open_map), settings_(settings), result_(result) {}
+
+  void run(BoundedQueue<LocatedScan>& in) {
+    Progress progress("frames", settings_.total_frames, settings_.quiet);
+    Clock::time_point last_flush = Clock::now();
+    while (std::optional<LocatedScan> scan = in.pop()) {
+      if (!map_) map_ = &open_map_(*scan);
+      const Eigen::Vector3d at = scan->T_map_sensor.translation();
+      Clock::time_point start = Clock::now();
+      map_->follow(
+          {static_cast<float>(at.x()), static_cast<float>(at.y()), static_cast<float>(at.z())});
+      result_.timings.shift_ms.push_back(ms_since(start));
+
+      start = Clock::now();
+      const tsdf::IntegrationStats stats = map_->integrator().integrate(scan->rays);
+      result_.timings.integrate_ms.push_back(ms_since(start));
+      result_.points += scan->rays.size();
+      result_.voxels_updated += stats.voxels_updated;
+      result_.poses.push_back(scan->stamp_ns, scan->T_map_sensor);
+      ++result_.frames_mapped;
+
+      if (std::chrono::duration<double>(Clock::now() - last_flush).count() >=
+          settings_.flush_interval_s) {
+        start = Clock::now();
+        map_->sync();
+        result_.timings.flush_ms.push_back(ms_since(start));
+        last_flush = Clock::now();
+      }
+      progress.update(result_.frames_read, status());
+    }
+  }
+
+ private:
+  std::string status() const {
+    const storage::ShiftingMapStats& stats = map_->stats();
+    char text[96];
+    std::snprintf(text, sizeof(text), "%zu mapped, %zu shifts, %zu chunks written",
+                  result_.frames_mapped, stats.shifts, stats.chunks_written);
+    return text;
+  }
+
+  const MapOpener& open_map_;
+  const PipelineSettings& settings_;
+  PipelineResult& result_;
+  storage::ShiftingMap* map_ = nullptr;
+};
+
+/// Runs `work` and turns an exception into a pipeline failure that stops every stage.
+template <typename Work>
+void guarded(PipelineState& state, const Work& work) {
+  try {
+    work();
+  } catch (...) {
+    state.fail(std::current_exception());
+  }
+}
+
+}  // namespace
+
+PipelineResult run_map_pipeline(slam::ScanSource& source, ScanLocator& locator,
+                                const MapOpener& open_map, const PipelineSettings& settings) {
+  PipelineResult result;
+  PipelineState state;
+  BoundedQueue<slam::Scan> scans(settings.queue_capacity);
+  BoundedQueue<LocatedScan> located(settings.queue_capacity);
+  const Clock::time_point start = Clock::now();
+
+  // Each stage closes its output when it ends, so the next one drains and ends too; a
+  // failing stage abandons its input so the one before it cannot block on a full queue.
+  std::thread reader([&] {
+    guarded(state, [&] { read_scans(source, settings.range, scans, state, result); });
+    scans.close();
+  });
+  std::thread front_end([&] {
+    guarded(state, [&] { locate_scans(locator, scans, located, state, result); });
+    if (state.stopping()) scans.abandon();
+    located.close();
+  });
+  guarded(state, [&] { MappingStage(open_map, settings, result).run(located); });
+  located.abandon();
+  scans.abandon();
+  front_end.join();
+  reader.join();
+
+  result.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  result.interrupted = StopSignal::requested();
+  if (!result.poses.empty()) {
+    result.recording_s =
+        static_cast<double>(result.poses.stamps_ns.back() - result.poses.stamps_ns.front()) * 1e-9;
+  }
+  const slam::ReadStats& read = source.stats();
+  for (const std::string& warning : read.warnings) {
+    if (result.warnings.size() < slam::ReadStats::kMaxKeptWarnings)
+      result.warnings.push_back(warning);
+  }
+  result.warning_count += read.warning_count;
+  state.rethrow_failure();
+  return result;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,71 @@
+#pragma once
+// The mapping pipeline: a reader thread, a front-end thread (the scan locator) and a mapping
+// thread (shift, TSDF integration, periodic flush of the store), joined by bounded queues.
+// A full queue makes the stage before it wait, so memory stays bounded however fast the
+// reader is; a failing stage stops the others and its error is rethrown after all joined.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/slam/scan_source.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+#include "featsense/storage/shifting_map.hpp"
+#include "scan_locator.hpp"
+
+namespace featsense::app {
+
+/// Which scans of the recording to map: frame indices (0-based, as scan.sequence) and/or
+/// seconds after the first scan; both ends inclusive.
+struct FrameRange {
+  std::optional<uint64_t> first_frame;
+  std::optional<uint64_t> last_frame;
+  std::optional<double> first_s;
+  std::optional<double> last_s;
+};
+
+struct PipelineSettings {
+  size_t queue_capacity = 4;  ///< scans per queue
+  double flush_interval_s = 30.0;
+  FrameRange range;
+  std::optional<size_t> total_frames;  ///< for the progress display, when known
+  bool quiet = false;
+};
+
+/// Per-stage times of each scan, milliseconds.
+struct StageTimings {
+  std::vector<double> read_ms;
+  std::vector<double> locate_ms;
+  std::vector<double> shift_ms;
+  std::vector<double> integrate_ms;
+  std::vector<double> flush_ms;
+};
+
+struct PipelineResult {
+  size_t frames_read = 0;    ///< scans the source handed out
+  size_t frames_mapped = 0;  ///< scans integrated into the map
+  size_t frames_without_pose = 0;
+  size_t frames_outside_range = 0;
+  size_t points = 0;  ///< rays integrated
+  size_t voxels_updated = 0;
+  StageTimings timings;
+  slam::Trajectory poses;  ///< the pose of every mapped scan, at its stamp
+  size_t warning_count = 0;
+  std::vector<std::string> warnings;  ///< the first few, verbatim
+  bool interrupted = false;           ///< stopped by Ctrl+C / SIGTERM
+  double wall_s = 0.0;
+  double recording_s = 0.0;  ///< time from the first to the last mapped scan's stamp
+};
+
+/// Creates the local map (centred on the first located scan) and ties it to the store; called
+/// once, from the mapping thread.
+using MapOpener = std::function<storage::ShiftingMap&(const LocatedScan& first)>;
+
+/// Runs the pipeline until the source ends, the range ends or a stop signal arrives. The
+/// caller syncs the map afterwards (also when this throws: what was integrated is in the map).
+PipelineResult run_map_pipeline(slam::ScanSource& source, ScanLocator& locator,
+                                const MapOpener& open_map, const PipelineSettings& settings);
+
+}  // namespace featsense::app

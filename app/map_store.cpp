@@ -1,0 +1,135 @@
+#include "map_store.hpp"
+
+#include <cmath>
+
+#include "featsense/config/config_error.hpp"
+#include "featsense/storage/vdb_io.hpp"
+
+namespace featsense::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+storage::MapMetadata metadata_of(const config::Config& config, const std::string& sensor_name) {
+  storage::MapMetadata m;
+  m.voxel_size_m = config.map.voxel_size_m;
+  m.truncation_m = config.map.truncation_m;
+  m.max_weight = config.map.max_weight;
+  m.sensor = sensor_name;
+  m.config_yaml = config::to_yaml(config);
+  return m;
+}
+
+bool same(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
+
+/// The old map's voxel size and tau win; values asked for explicitly must agree with them.
+void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
+                        config::Config& config) {
+  const config::MapConfig defaults;
+  const auto adopt = [&](const char* key, double& value, double default_value, double old_value) {
+    if (!same(value, default_value) && !same(value, old_value)) {
+      throw config::ConfigError(std::string(key) + " = " + std::to_string(value) +
+                                " differs from the continued map's " + std::to_string(old_value) +
+                                " (" + what + "); a map keeps its voxel size and tau");
+    }
+    value = old_value;
+  };
+  adopt("map.voxel_size", config.map.voxel_size_m, defaults.voxel_size_m, old_map.voxel_size_m);
+  adopt("map.truncation", config.map.truncation_m, defaults.truncation_m, old_map.truncation_m);
+}
+
+slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses) {
+  slam::Trajectory trajectory;
+  for (const storage::TrajectoryPose& p : poses) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::Quaterniond(p.qw, p.qx, p.qy, p.qz).normalized().toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(p.x, p.y, p.z);
+    trajectory.push_back(static_cast<int64_t>(std::llround(p.t_s * 1e9)), pose);
+  }
+  return trajectory;
+}
+
+/// Copies every chunk of `from` into `to`.
+size_t copy_chunks(storage::ChunkStore& from, storage::ChunkStore& to) {
+  size_t copied = 0;
+  for (const storage::ChunkKey& key : from.keys()) {
+    if (std::optional<storage::Chunk> chunk = from.read(key)) {
+      to.write(key, *chunk);
+      ++copied;
+    }
+  }
+  return copied;
+}
+
+}  // namespace
+
+std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory) {
+  std::vector<storage::TrajectoryPose> poses;
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    const Eigen::Isometry3d& T = trajectory.poses[i];
+    const Eigen::Quaterniond q(T.linear());
+    storage::TrajectoryPose p;
+    p.t_s = static_cast<double>(trajectory.stamps_ns[i]) * 1e-9;
+    p.x = T.translation().x();
+    p.y = T.translation().y();
+    p.z = T.translation().z();
+    p.qx = q.x();
+    p.qy = q.y();
+    p.qz = q.z();
+    p.qw = q.w();
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+MapStore open_map_store(const fs::path& path, config::Config& config,
+                        const std::string& sensor_name,
+                        const std::optional<std::string>& continue_from, bool overwrite) {
+  MapStore result;
+  const storage::OpenMode create =
+      overwrite ? storage::OpenMode::kCreateOverwrite : storage::OpenMode::kCreate;
+  if (!continue_from) {
+    if (fs::exists(path) && !overwrite) {
+      throw std::runtime_error(path.string() +
+                               " exists; pass --overwrite to replace it, or --continue it");
+    }
+    result.store =
+        std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
+    return result;
+  }
+
+  const fs::path old_path(*continue_from);
+  if (!fs::exists(old_path))
+    throw std::runtime_error("--continue: no such map: " + old_path.string());
+  const bool in_place = fs::exists(path) && fs::equivalent(old_path, path);
+  if (old_path.extension() == ".vdb") {
+    // A .vdb carries voxel size and tau; the rest of the metadata comes from this run.
+    adopt_map_geometry(storage::read_vdb_metadata(old_path), old_path.string(), config);
+    result.store =
+        std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
+    result.continued_chunks = storage::import_vdb(old_path, *result.store).chunks;
+    return result;
+  }
+  if (in_place) {
+    storage::Hdf5ChunkStore probe(old_path);
+    adopt_map_geometry(probe.metadata(), old_path.string(), config);
+    result.earlier_poses = from_store_poses(probe.read_trajectory());
+    result.continued_chunks = probe.keys().size();
+    probe.close();
+    result.store = std::make_unique<storage::Hdf5ChunkStore>(path, storage::OpenMode::kAppend,
+                                                             metadata_of(config, sensor_name));
+    return result;
+  }
+  if (fs::exists(path) && !overwrite) {
+    throw std::runtime_error(path.string() + " exists; pass --overwrite to replace it");
+  }
+  storage::Hdf5ChunkStore old_map(old_path);
+  adopt_map_geometry(old_map.metadata(), old_path.string(), config);
+  result.earlier_poses = from_store_poses(old_map.read_trajectory());
+  result.store =
+      std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
+  result.continued_chunks = copy_chunks(old_map, *result.store);
+  return result;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,34 @@
+#pragma once
+// The store of a `featsense map` run: a new OUT/map.h5, or one that continues an existing
+// map (.h5 or .vdb), whose voxel size and tau then win over the configuration.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "featsense/config/config.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+
+namespace featsense::app {
+
+struct MapStore {
+  std::unique_ptr<storage::Hdf5ChunkStore> store;
+  slam::Trajectory earlier_poses;  ///< the trajectory of the map that was continued
+  size_t continued_chunks = 0;
+};
+
+/// Creates `path` for a map of `config` (an existing file is an error unless `overwrite`),
+/// or, with `continue_from`, a copy of that map at `path` (in place when it is `path`).
+/// With `continue_from`, config.map.voxel_size and map.truncation are set to the old map's;
+/// a configuration that asked for other values explicitly (not the defaults) is a
+/// ConfigError naming both.
+MapStore open_map_store(const std::filesystem::path& path, config::Config& config,
+                        const std::string& sensor_name,
+                        const std::optional<std::string>& continue_from, bool overwrite);
+
+/// The store's trajectory form of `trajectory`.
+std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory);
+
+}  // namespace featsense::app

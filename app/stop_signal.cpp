@@ -1,0 +1,48 @@
+#include "stop_signal.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+
+namespace featsense::app {
+namespace {
+
+std::atomic<int> g_signals{0};
+struct sigaction g_old_int {};
+struct sigaction g_old_term {};
+
+extern "C" void on_stop_signal(int) {
+  // Only async-signal-safe calls here: an atomic counter, write(2) and _exit(2).
+  if (g_signals.fetch_add(1) == 0) {
+    static const char kFirst[] =
+        "\nfeatsense: stopping: finishing the scans in flight and writing the map "
+        "(press Ctrl+C again to quit at once)\n";
+    [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kFirst, sizeof(kFirst) - 1);
+    return;
+  }
+  static const char kSecond[] = "\nfeatsense: quit; the map holds what was flushed before\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kSecond, sizeof(kSecond) - 1);
+  ::_exit(130);
+}
+
+}  // namespace
+
+StopSignal::StopSignal() {
+  g_signals.store(0);
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &action, &g_old_int);
+  sigaction(SIGTERM, &action, &g_old_term);
+}
+
+StopSignal::~StopSignal() {
+  sigaction(SIGINT, &g_old_int, nullptr);
+  sigaction(SIGTERM, &g_old_term, nullptr);
+}
+
+bool StopSignal::requested() { return g_signals.load() > 0; }
+
+}  // namespace featsense::app

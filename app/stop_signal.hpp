@@ -1,0 +1,20 @@
+#pragma once
+// Ctrl+C and SIGTERM during a long run: the first asks the run to stop (it finishes the
+// scans in flight, writes the map and the report); the second exits at once, leaving the
+// store as a crash would (readable up to its last flush).
+
+namespace featsense::app {
+
+class StopSignal {
+ public:
+  /// Installs the handlers for SIGINT and SIGTERM; the destructor restores the old ones.
+  StopSignal();
+  ~StopSignal();
+  StopSignal(const StopSignal&) = delete;
+  StopSignal& operator=(const StopSignal&) = delete;
+
+  /// True once SIGINT or SIGTERM arrived.
+  static bool requested();
+};
+
+}  // namespace featsense::app
