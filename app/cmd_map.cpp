@@ -196,6 +196,10 @@ void run_map(const MapOptions& options, const CliContext& context) {
                                                          ? std::string()
                                                          : ": " + result.warnings.front()));
   }
+  if (result.interrupted) {
+    throw Interrupted("interrupted after " + std::to_string(result.frames_mapped) +
+                      " scans; their map, poses and report are in " + out.string());
+  }
   if (!context.quiet) {
     std::printf("%s%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
                 result.interrupted ? "interrupted: " : "", result.frames_mapped, result.wall_s,

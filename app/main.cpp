@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/scan_source.hpp"
+#include "stop_signal.hpp"
 
 namespace {
 
@@ -80,6 +81,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const featsense::config::ConfigError& e) {
     return fail(std::string("config: ") + e.what(), 2);
+  } catch (const featsense::app::Interrupted& e) {
+    return fail(e.what(), 130);
   } catch (const featsense::slam::InputError& e) {
     return fail(e.what(), 1);
   } catch (const std::exception& e) {

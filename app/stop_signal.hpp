@@ -3,7 +3,16 @@
 // scans in flight, writes the map and the report); the second exits at once, leaving the
 // store as a crash would (readable up to its last flush).
 
+#include <stdexcept>
+
 namespace featsense::app {
+
+/// A run that a signal stopped after writing what it had: the program exits with 130, as a
+/// shell reports a process that SIGINT ended.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class StopSignal {
  public:

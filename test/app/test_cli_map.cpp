@@ -1,0 +1,248 @@
+// `featsense map` end to end on a simulated sequence: its outputs, continuing a map, the
+// errors users meet, and a run stopped by SIGINT or killed with SIGKILL.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "common/run_command.hpp"
+#include "common/test_data.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+
+namespace featsense::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small, coarse map keeps each run to seconds on two cores.
+const std::string kSmallMap =
+    " --quiet --backend cpu --set map.size=[16,16,8] --set map.voxel_size=0.1"
+    " --set map.truncation=0.3 --set map.shift_threshold=1.0";
+
+class CliMap : public ::testing::Test {
+ public:
+  static void SetUpTestSuite() {
+    sequence_ = new fs::path(scratch_dir("cli_map_sequence") / "lab");
+    const CommandResult sim =
+        run_featsense("simulate --quiet --scene lab --frames 24 -o " + sequence_->string());
+    ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  }
+  static void TearDownTestSuite() { delete sequence_; }
+
+  static std::string sequence() { return sequence_->string(); }
+  static std::string gt() { return (*sequence_ / "gt_trajectory.tum").string(); }
+
+ private:
+  static fs::path* sequence_;
+};
+fs::path* CliMap::sequence_ = nullptr;
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+size_t count_lines(const fs::path& path) {
+  std::ifstream in(path);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) n += line.empty() || line[0] == '#' ? 0 : 1;
+  return n;
+}
+
+TEST_F(CliMap, WritesTheMapThePosesAndTheReport) {
+  const fs::path out = scratch_dir("cli_map_outputs");
+  const CommandResult run =
+      run_featsense("map " + sequence() + " -o " + out.string() + " --gt " + gt() + kSmallMap);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* name : {"map.h5", "trajectory.tum", "trajectory.kitti", "report.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  }
+  EXPECT_EQ(count_lines(out / "trajectory.tum"), 24u);
+  EXPECT_EQ(count_lines(out / "trajectory.kitti"), 24u);
+
+  const nlohmann::json report = read_json(out / "report.json");
+  EXPECT_EQ(report["frames"], 24);
+  EXPECT_EQ(report["backend"], "cpu");
+  EXPECT_FALSE(report["interrupted"].get<bool>());
+  EXPECT_GT(report["scans_per_s"].get<double>(), 0.0);
+  EXPECT_GT(report["peak_rss_mb"].get<double>(), 0.0);
+  EXPECT_EQ(report["timings"]["integrate"]["count"], 24);
+  EXPECT_GT(report["timings"]["integrate"]["median_ms"].get<double>(), 0.0);
+  EXPECT_GE(report["map"]["shifts"].get<int>(), 1) << "the lab walk is longer than 1 m";
+
+  storage::Hdf5ChunkStore store(out / "map.h5");
+  EXPECT_NEAR(store.metadata().voxel_size_m, 0.1, 1e-12);
+  EXPECT_NEAR(store.metadata().truncation_m, 0.3, 1e-12);
+  EXPECT_NE(store.metadata().config_yaml.find("voxel_size: 0.1"), std::string::npos);
+  EXPECT_EQ(store.read_trajectory().size(), 24u);
+  EXPECT_EQ(store.keys().size(), report["map"]["chunks"].get<size_t>());
+  EXPECT_GT(store.keys().size(), 4u);
+}
+
+/// Every chunk of two stores is equal, and they hold the same keys.
+void expect_same_maps(const fs::path& a, const fs::path& b) {
+  storage::Hdf5ChunkStore first(a);
+  storage::Hdf5ChunkStore second(b);
+  ASSERT_EQ(first.keys(), second.keys());
+  for (const storage::ChunkKey& key : first.keys()) {
+    EXPECT_TRUE(*first.read(key) == *second.read(key))
+        << "chunk " << key.x << " " << key.y << " " << key.z;
+  }
+}
+
+TEST_F(CliMap, ContinuingAMapGivesTheMapOfOneRun) {
+  const fs::path dir = scratch_dir("cli_map_continue");
+  const std::string common = " --gt " + gt() + kSmallMap;
+  ASSERT_EQ(
+      run_featsense("map " + sequence() + " -o " + (dir / "whole").string() + common).exit_code, 0);
+  const CommandResult first =
+      run_featsense("map " + sequence() + " -o " + (dir / "first").string() + " --end 11" + common);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const CommandResult second =
+      run_featsense("map " + sequence() + " -o " + (dir / "second").string() +
+                    " --start 12 --continue " + (dir / "first" / "map.h5").string() + common);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  EXPECT_EQ(count_lines(dir / "second" / "trajectory.tum"), 12u);
+  storage::Hdf5ChunkStore continued(dir / "second" / "map.h5");
+  EXPECT_EQ(continued.read_trajectory().size(), 24u) << "the old poses and the new";
+  expect_same_maps(dir / "whole" / "map.h5", dir / "second" / "map.h5");
+}
+
+TEST_F(CliMap, ContinuingFromAVdbKeepsItsVoxelSize) {
+  const fs::path dir = scratch_dir("cli_map_continue_vdb");
+  ASSERT_EQ(run_featsense("map " + sequence() + " -o " + (dir / "first").string() +
+                          " --end 5 --gt " + gt() + kSmallMap)
+                .exit_code,
+            0);
+  const std::string vdb = (dir / "first.vdb").string();
+  const CommandResult exported =
+      run_featsense("export " + (dir / "first" / "map.h5").string() + " -o " + vdb);
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  // No voxel size given: the .vdb's 0.1 m wins over the default 0.064 m.
+  const CommandResult second = run_featsense(
+      "map " + sequence() + " -o " + (dir / "second").string() + " --start 6 --end 8 --gt " + gt() +
+      " --quiet --backend cpu --set map.size=[16,16,8] --continue " + vdb);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  storage::Hdf5ChunkStore store(dir / "second" / "map.h5");
+  EXPECT_NEAR(store.metadata().voxel_size_m, 0.1, 1e-9);
+  EXPECT_NEAR(store.metadata().truncation_m, 0.3, 1e-6);
+}
+
+TEST_F(CliMap, BadInputGivesOneClearError) {
+  const fs::path dir = scratch_dir("cli_map_errors");
+  const std::string out = " -o " + (dir / "out").string();
+
+  CommandResult r = run_featsense("map " + sequence() + out + kSmallMap);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("needs the sensor's poses: pass --gt"), std::string::npos) << r.output;
+
+  ASSERT_EQ(
+      run_featsense("map " + sequence() + out + " --end 2 --gt " + gt() + kSmallMap).exit_code, 0);
+  r = run_featsense("map " + sequence() + out + " --end 2 --gt " + gt() + kSmallMap);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("exists; pass --overwrite"), std::string::npos) << r.output;
+  EXPECT_EQ(
+      run_featsense("map " + sequence() + out + " --end 2 --overwrite --gt " + gt() + kSmallMap)
+          .exit_code,
+      0);
+
+  r = run_featsense("map " + sequence() + " -o " + (dir / "other").string() + " --gt " + gt() +
+                    kSmallMap + " --set map.voxel_size=0.2 --continue " +
+                    (dir / "out" / "map.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("map.voxel_size = 0.2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("differs from the continued map's 0.1"), std::string::npos) << r.output;
+
+  const fs::path foreign = dir / "foreign.h5";
+  std::ofstream(foreign) << "not an HDF5 file";
+  r = run_featsense("map " + sequence() + " -o " + (dir / "other2").string() + " --gt " + gt() +
+                    kSmallMap + " --continue " + foreign.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find(foreign.string()), std::string::npos) << r.output;
+
+  const fs::path wrong_times = dir / "late.tum";
+  std::ofstream(wrong_times) << "1000.0 0 0 1 0 0 0 1\n1001.0 1 0 1 0 0 0 1\n";
+  r = run_featsense("map " + sequence() + " -o " + (dir / "late").string() + " --gt " +
+                    wrong_times.string() + kSmallMap);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("no scan was mapped: skipped: no pose for scan 0"), std::string::npos)
+      << r.output;
+
+  r = run_featsense("map " + sequence() + " -o " + (dir / "range").string() + " --gt " + gt() +
+                    kSmallMap + " --start ten");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--start: expected a frame index"), std::string::npos) << r.output;
+}
+
+/// Starts `featsense ARGS` as a child process; returns its pid.
+pid_t spawn_featsense(const std::string& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string command =
+        "exec " + featsense_program() + " " + args + " >" + log.string() + " 2>&1 </dev/null";
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Waits until the store's journal holds a flushed chunk (or the child ended).
+bool wait_for_first_flush(const fs::path& journal, pid_t child) {
+  for (int i = 0; i < 600; ++i) {
+    if (fs::exists(journal) && fs::file_size(journal) > 4096) return true;
+    int status = 0;
+    if (waitpid(child, &status, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+std::string long_run_args(const fs::path& out) {
+  return "map " + CliMap::sequence() + " -o " + out.string() + " --gt " + CliMap::gt() +
+         " --quiet --backend cpu --set map.flush_interval=1";
+}
+
+TEST_F(CliMap, KillNineLeavesAReadableMap) {
+  const fs::path out = scratch_dir("cli_map_kill");
+  const pid_t child = spawn_featsense(long_run_args(out), out.parent_path() / "kill.log");
+  ASSERT_TRUE(wait_for_first_flush(out / "map.h5.journal", child))
+      << "the run ended before its first flush";
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  storage::Hdf5ChunkStore store(out / "map.h5");  // replays the journal
+  EXPECT_GT(store.keys().size(), 0u);
+  for (const storage::ChunkKey& key : store.keys()) ASSERT_TRUE(store.read(key).has_value());
+}
+
+TEST_F(CliMap, SigintWritesTheMapOfWhatWasRead) {
+  const fs::path out = scratch_dir("cli_map_sigint");
+  const pid_t child = spawn_featsense(long_run_args(out), out.parent_path() / "sigint.log");
+  ASSERT_TRUE(wait_for_first_flush(out / "map.h5.journal", child))
+      << "the run ended before its first flush";
+  kill(child, SIGINT);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const nlohmann::json report = read_json(out / "report.json");
+  EXPECT_TRUE(report["interrupted"].get<bool>());
+  const size_t frames = report["frames"].get<size_t>();
+  EXPECT_GT(frames, 0u);
+  EXPECT_LT(frames, 24u);
+  storage::Hdf5ChunkStore store(out / "map.h5");
+  EXPECT_EQ(store.read_trajectory().size(), frames);
+  EXPECT_EQ(store.keys().size(), report["map"]["chunks"].get<size_t>());
+}
+
+}  // namespace
+}  // namespace featsense::test
