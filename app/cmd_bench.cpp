@@ -7,12 +7,11 @@
 #include <iostream>
 #include <sstream>
 
+#include "bench_scans.hpp"
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "json_output.hpp"
-#include "scan_to_rays.hpp"
 #include "source_options.hpp"
 #include "timing_stats.hpp"
 
@@ -30,75 +29,9 @@ struct BenchTsdfOptions {
   std::optional<std::string> json_path;
 };
 
-std::array<double, 3> parse_map_size(const std::string& text) {
-  std::array<double, 3> size{};
-  char x1 = 0;
-  char x2 = 0;
-  std::istringstream in(text);
-  if (!(in >> size[0] >> x1 >> size[1] >> x2 >> size[2]) || x1 != 'x' || x2 != 'x' || !in.eof()) {
-    throw config::ConfigError("--map: expected XxYxZ in metres, e.g. 40x40x15, got '" + text + "'");
-  }
-  return size;
-}
-
-/// The built-in scans: an OS1-128 moving through a 20 x 20 x 4 m room (indoor ranges) or
-/// through a 120 x 80 m yard open to the sky (outdoor ranges, beams above the horizon lost).
-struct PreparedScans {
-  std::vector<tsdf::RayBatch> rays;
-  config::SensorModel sensor;
-  std::string description;
-  size_t input_points = 0;
-};
-
-PreparedScans prepare_builtin(const std::string& scene, int count) {
-  slam::BoxRoomSettings settings = slam::default_box_room();
-  settings.frames = count;
-  if (scene == "outdoor") {
-    settings.room_min_m = Eigen::Vector3d(-60, -40, 0);
-    settings.room_max_m = Eigen::Vector3d(60, 40, 1e4);
-    settings.velocity_mps = Eigen::Vector3d(5, 0, 0);
-  }
-  PreparedScans prepared;
-  prepared.sensor = settings.sensor;
-  prepared.description = "built-in " + scene + " scene, os1-128 1024 x 128, moving sensor";
-  auto source = slam::make_box_room_source(settings);
-  int frame = 0;
-  while (auto scan = source->next()) {
-    const double frame_start = frame / settings.sensor.rate_hz;
-    prepared.rays.push_back(deskewed_scan_to_rays(
-        *scan, [&](double t) { return slam::box_room_pose(settings, frame_start + t); }));
-    prepared.input_points += prepared.rays.back().size();
-    ++frame;
-  }
-  return prepared;
-}
-
-PreparedScans prepare_recording(const InputOptions& input, const config::Config& config,
-                                int count) {
-  std::unique_ptr<slam::ScanSource> source = input.open(config);
-  PreparedScans prepared;
-  prepared.sensor = source->info().sensor;
-  prepared.description = source->info().format + " " + input.input + " (frames at the origin)";
-  while (static_cast<int>(prepared.rays.size()) < count) {
-    std::optional<slam::Scan> scan = source->next();
-    if (!scan) break;
-    prepared.rays.push_back(scan_to_rays(*scan, Eigen::Isometry3d::Identity()));
-    prepared.input_points += prepared.rays.back().size();
-  }
-  if (prepared.rays.empty()) throw slam::InputError(input.input + ": no readable frame");
-  return prepared;
-}
-
 nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext& context) {
-  config::Config config = context.load_config();
-  std::vector<std::string> overrides = context.overrides;
   const std::array<double, 3> size = parse_map_size(options.map_size);
-  std::ostringstream set_size;
-  set_size << "map.size=[" << size[0] << "," << size[1] << "," << size[2] << "]";
-  overrides.push_back(set_size.str());
-  overrides.push_back("map.voxel_size=" + std::to_string(options.voxel_size_m));
-  overrides.push_back("map.backend=" + options.backend);
-  config = config::load_config(context.config_path, overrides);
+  const config::Config config = bench_config(context, size, options.voxel_size_m, options.backend);
 
   const PreparedScans scans = options.input.input.empty()
                                   ? prepare_builtin(options.scene, options.scans)

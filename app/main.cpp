@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
                                                    featsense::app::register_export(app, context),
                                                    featsense::app::register_navmesh(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
+  commands.push_back(featsense::app::register_bench_store(*app.get_subcommand("bench"), context));
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.
   for (const auto& command : commands) {

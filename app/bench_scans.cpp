@@ -1,0 +1,74 @@
+#include "bench_scans.hpp"
+
+#include <optional>
+#include <sstream>
+
+#include "featsense/config/config_error.hpp"
+
+#include "featsense/slam/sim/box_room_source.hpp"
+#include "scan_to_rays.hpp"
+
+namespace featsense::app {
+
+std::array<double, 3> parse_map_size(const std::string& text) {
+  std::array<double, 3> size{};
+  char x1 = 0;
+  char x2 = 0;
+  std::istringstream in(text);
+  if (!(in >> size[0] >> x1 >> size[1] >> x2 >> size[2]) || x1 != 'x' || x2 != 'x' || !in.eof()) {
+    throw config::ConfigError("--map: expected XxYxZ in metres, e.g. 40x40x15, got '" + text + "'");
+  }
+  return size;
+}
+
+config::Config bench_config(const CliContext& context, const std::array<double, 3>& map_size_m,
+                            double voxel_size_m, const std::string& backend) {
+  std::vector<std::string> overrides = context.overrides;
+  std::ostringstream set_size;
+  set_size << "map.size=[" << map_size_m[0] << "," << map_size_m[1] << "," << map_size_m[2] << "]";
+  overrides.push_back(set_size.str());
+  overrides.push_back("map.voxel_size=" + std::to_string(voxel_size_m));
+  overrides.push_back("map.backend=" + backend);
+  return config::load_config(context.config_path, overrides);
+}
+
+PreparedScans prepare_builtin(const std::string& scene, int count) {
+  slam::BoxRoomSettings settings = slam::default_box_room();
+  settings.frames = count;
+  if (scene == "outdoor") {
+    settings.room_min_m = Eigen::Vector3d(-60, -40, 0);
+    settings.room_max_m = Eigen::Vector3d(60, 40, 1e4);
+    settings.velocity_mps = Eigen::Vector3d(5, 0, 0);
+  }
+  PreparedScans prepared;
+  prepared.sensor = settings.sensor;
+  prepared.description = "built-in " + scene + " scene, os1-128 1024 x 128, moving sensor";
+  auto source = slam::make_box_room_source(settings);
+  int frame = 0;
+  while (auto scan = source->next()) {
+    const double frame_start = frame / settings.sensor.rate_hz;
+    prepared.rays.push_back(deskewed_scan_to_rays(
+        *scan, [&](double t) { return slam::box_room_pose(settings, frame_start + t); }));
+    prepared.input_points += prepared.rays.back().size();
+    ++frame;
+  }
+  return prepared;
+}
+
+PreparedScans prepare_recording(const InputOptions& input, const config::Config& config,
+                                int count) {
+  std::unique_ptr<slam::ScanSource> source = input.open(config);
+  PreparedScans prepared;
+  prepared.sensor = source->info().sensor;
+  prepared.description = source->info().format + " " + input.input + " (frames at the origin)";
+  while (static_cast<int>(prepared.rays.size()) < count) {
+    std::optional<slam::Scan> scan = source->next();
+    if (!scan) break;
+    prepared.rays.push_back(scan_to_rays(*scan, Eigen::Isometry3d::Identity()));
+    prepared.input_points += prepared.rays.back().size();
+  }
+  if (prepared.rays.empty()) throw slam::InputError(input.input + ": no readable frame");
+  return prepared;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,39 @@
+#pragma once
+// The scans the benchmarks integrate: built-in OS1-128 scans of an analytic scene, or the
+// first frames of a recording.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "cli_context.hpp"
+#include "featsense/config/config.hpp"
+#include "featsense/config/sensor_model.hpp"
+#include "featsense/tsdf/ray_batch.hpp"
+#include "source_options.hpp"
+
+namespace featsense::app {
+
+/// --map XxYxZ (metres). Throws ConfigError.
+std::array<double, 3> parse_map_size(const std::string& text);
+
+/// The run's configuration with the benchmark's map size, voxel size and backend.
+config::Config bench_config(const CliContext& context, const std::array<double, 3>& map_size_m,
+                            double voxel_size_m, const std::string& backend);
+
+/// Scans as rays in the map frame, ready to integrate.
+struct PreparedScans {
+  std::vector<tsdf::RayBatch> rays;
+  config::SensorModel sensor;
+  std::string description;
+  size_t input_points = 0;
+};
+
+/// `count` scans of an OS1-128 moving through a 20 x 20 x 4 m room ("indoor") or through a
+/// 120 x 80 m yard open to the sky ("outdoor": outdoor ranges, beams above the horizon lost).
+PreparedScans prepare_builtin(const std::string& scene, int count);
+
+/// The first `count` frames of a recording, each at the origin. Throws slam::InputError.
+PreparedScans prepare_recording(const InputOptions& input, const config::Config& config, int count);
+
+}  // namespace featsense::app
