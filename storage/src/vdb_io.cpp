@@ -80,6 +80,28 @@ VdbExportStats export_vdb(ChunkStore& store, const std::filesystem::path& vdb_pa
   return stats;
 }
 
+MapMetadata read_vdb_metadata(const std::filesystem::path& vdb_path) {
+  openvdb::initialize();
+  openvdb::GridBase::Ptr tsdf;
+  try {
+    openvdb::io::File file(vdb_path.string());
+    file.open();
+    if (!file.hasGrid("tsdf") || !file.hasGrid("weight"))
+      throw std::runtime_error("no float grids 'tsdf' and 'weight' in " + vdb_path.string());
+    tsdf = file.readGridMetadata("tsdf");
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    throw std::runtime_error("cannot read " + vdb_path.string() + ": " + e.what());
+  }
+  const auto tau_meta = tsdf->getMetadata<openvdb::DoubleMetadata>(kTruncationKey);
+  if (!tau_meta)
+    throw std::runtime_error("grid 'tsdf' has no truncation_m metadata: " + vdb_path.string());
+  MapMetadata metadata;
+  metadata.voxel_size_m = tsdf->voxelSize()[0];
+  metadata.truncation_m = tau_meta->value();
+  return metadata;
+}
+
 VdbExportStats import_vdb(const std::filesystem::path& vdb_path, ChunkStore& store) {
   openvdb::initialize();
   openvdb::FloatGrid::Ptr tsdf;

@@ -19,6 +19,11 @@ struct VdbExportStats {
 /// Writes every chunk of `store` to `vdb_path`. Throws std::runtime_error (with the path).
 VdbExportStats export_vdb(ChunkStore& store, const std::filesystem::path& vdb_path);
 
+/// The voxel size and tau of a .vdb made by export_vdb (the rest of MapMetadata at its
+/// defaults), read without its voxels: what a store needs before import_vdb. Throws
+/// std::runtime_error naming the file when it cannot be read or lacks the grids or tau.
+MapMetadata read_vdb_metadata(const std::filesystem::path& vdb_path);
+
 /// Writes the voxels of a .vdb made by export_vdb into `store`, converting back to the fixed
 /// point of voxel.hpp, which export_vdb's floats hold exactly enough to round back to the
 /// same integers. The file's voxel size and tau must match the store's, else
