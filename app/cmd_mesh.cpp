@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/mesh/marching_cubes.hpp"
+#include "featsense/mesh/mesh_cleanup.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/storage/memory_chunk_store.hpp"
 #include "featsense/storage/vdb_io.hpp"
@@ -29,6 +30,11 @@ struct MeshOptions {
   double min_weight = mesh::MeshingSettings{}.min_weight;
   int threads = 0;
   std::size_t cache_mb = 64;
+  bool clean = false;
+  double simplify_ratio = 1.0;
+  double min_component_area_m2 = 0.25;
+  double max_hole_perimeter_m = 1.0;
+  bool check_self_intersections = false;
   std::optional<std::string> json_path;
 };
 
@@ -98,6 +104,14 @@ void run_mesh(const MeshOptions& options) {
     throw config::ConfigError("--threads: must be >= 0 (0 = all cores), got " +
                               std::to_string(options.threads));
   }
+  if (!(options.simplify_ratio > 0.0 && options.simplify_ratio <= 1.0)) {
+    throw config::ConfigError(
+        "--simplify: the fraction of triangles to keep must be in (0, 1], got " +
+        std::to_string(options.simplify_ratio));
+  }
+  if (!(options.min_component_area_m2 >= 0.0) || !(options.max_hole_perimeter_m >= 0.0)) {
+    throw config::ConfigError("--min-component-area and --max-hole must be >= 0");
+  }
   mesh::MeshingSettings settings;
   settings.min_weight = options.min_weight;
   settings.threads = options.threads;
@@ -113,13 +127,40 @@ void run_mesh(const MeshOptions& options) {
                              std::to_string(stats.chunks) + " chunks, min weight " +
                              std::to_string(options.min_weight) + ")");
   }
+  std::optional<mesh::CleanupReport> cleanup;
+  if (options.clean || options.simplify_ratio < 1.0 || options.check_self_intersections) {
+    mesh::CleanupSettings cleaning;
+    if (options.clean) {
+      cleaning.min_component_area_m2 = options.min_component_area_m2;
+      cleaning.max_hole_perimeter_m = options.max_hole_perimeter_m;
+    }
+    cleaning.simplify_ratio = options.simplify_ratio;
+    cleaning.check_self_intersections = options.check_self_intersections;
+    cleanup = mesh::clean_mesh(result, cleaning);
+    if (result.triangles.empty()) {
+      throw std::runtime_error(options.map + ": nothing left after cleaning (" +
+                               std::to_string(cleanup->removed_components) +
+                               " small components removed)");
+    }
+  }
   viewer_export::write_mesh(options.output, result);
 
   const double triangles_per_s =
       stats.seconds > 0.0 ? static_cast<double>(stats.triangles) / stats.seconds : 0.0;
-  std::printf("%s: %zu vertices, %zu triangles from %zu chunks in %.2f s (%.2f M triangles/s)\n",
-              options.output.c_str(), result.vertices.size(), result.triangles.size(), stats.chunks,
-              stats.seconds, triangles_per_s * 1e-6);
+  std::printf(
+      "%s: %zu vertices, %zu triangles (meshed: %zu) from %zu chunks in %.2f s (%.2f M "
+      "triangles/s)\n",
+      options.output.c_str(), result.vertices.size(), result.triangles.size(), stats.triangles,
+      stats.chunks, stats.seconds, triangles_per_s * 1e-6);
+  if (cleanup) {
+    std::printf(
+        "cleanup: %zu -> %zu triangles, %zu small components removed, %zu non-manifold vertices "
+        "split, %zu holes filled, simplification error max %.4f m mean %.4f m, %s, %s\n",
+        cleanup->input_triangles, cleanup->output_triangles, cleanup->removed_components,
+        cleanup->non_manifold_vertices_fixed, cleanup->holes_filled,
+        cleanup->simplification_max_error_m, cleanup->simplification_mean_error_m,
+        cleanup->is_closed ? "closed" : "open", cleanup->is_manifold ? "manifold" : "not manifold");
+  }
   if (options.json_path) {
     nlohmann::json report = {{"map", options.map},
                              {"output", options.output},
@@ -134,6 +175,28 @@ void run_mesh(const MeshOptions& options) {
       report["bbox"] = {settings.bbox->min().x(), settings.bbox->min().y(),
                         settings.bbox->min().z(), settings.bbox->max().x(),
                         settings.bbox->max().y(), settings.bbox->max().z()};
+    }
+    if (cleanup) {
+      const mesh::CleanupReport& c = *cleanup;
+      report["cleanup"] = {{"input_triangles", c.input_triangles},
+                           {"output_triangles", c.output_triangles},
+                           {"output_vertices", c.output_vertices},
+                           {"degenerate_triangles_removed", c.degenerate_triangles_removed},
+                           {"removed_components", c.removed_components},
+                           {"removed_component_triangles", c.removed_component_triangles},
+                           {"non_manifold_vertices_fixed", c.non_manifold_vertices_fixed},
+                           {"holes_filled", c.holes_filled},
+                           {"holes_left", c.holes_left},
+                           {"simplify_ratio", options.simplify_ratio},
+                           {"simplification_max_error_m", c.simplification_max_error_m},
+                           {"simplification_mean_error_m", c.simplification_mean_error_m},
+                           {"border_edges", c.border_edges},
+                           {"is_closed", c.is_closed},
+                           {"is_manifold", c.is_manifold},
+                           {"is_valid", c.is_valid},
+                           {"seconds", c.seconds}};
+      if (options.check_self_intersections)
+        report["cleanup"]["self_intersections"] = c.self_intersections;
     }
     write_json(report, *options.json_path);
   }
@@ -160,6 +223,23 @@ Command register_mesh(CLI::App& app, const CliContext& /*context*/) {
   command->add_option("--cache-mb", options->cache_mb, "Chunk cache of an .h5 map, MiB")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
+  command->add_flag("--clean", options->clean,
+                    "Remove small components (--min-component-area), split non-manifold "
+                    "vertices, fill holes (--max-hole)");
+  command
+      ->add_option("--min-component-area", options->min_component_area_m2,
+                   "With --clean: smaller components are removed, square metres")
+      ->capture_default_str();
+  command
+      ->add_option("--max-hole", options->max_hole_perimeter_m,
+                   "With --clean: holes with a shorter border are filled, metres (0 = none)")
+      ->capture_default_str();
+  command
+      ->add_option("--simplify", options->simplify_ratio,
+                   "Keep this fraction of the triangles (0, 1] by edge collapse; borders stay")
+      ->capture_default_str();
+  command->add_flag("--check-self-intersections", options->check_self_intersections,
+                    "Count self-intersecting triangle pairs of the result (slow on big meshes)");
   command->add_option("--json", options->json_path, "Write the figures as JSON ('-' = stdout)");
   return {command, [options] { run_mesh(*options); }};
 }
