@@ -32,6 +32,8 @@ Command register_bench(CLI::App& app, const CliContext& context);
 std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
 /// `featsense export MESH -o FILE`: a mesh in another format, chosen by the extension.
 Command register_export(CLI::App& app, const CliContext& context);
+/// `featsense mesh MAP -o MESH`: marching cubes over a stored map.
+Command register_mesh(CLI::App& app, const CliContext& context);
 /// `featsense navmesh MESH -o NAV`: traversability layers for mesh-based navigation.
 Command register_navmesh(CLI::App& app, const CliContext& context);
 

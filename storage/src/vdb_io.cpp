@@ -86,6 +86,8 @@ MapMetadata read_vdb_metadata(const std::filesystem::path& vdb_path) {
   try {
     openvdb::io::File file(vdb_path.string());
     file.open();
+    if (!file.hasGrid("tsdf") || !file.hasGrid("weight"))
+      throw std::runtime_error("no float grids 'tsdf' and 'weight' in " + vdb_path.string());
     tsdf = file.readGridMetadata("tsdf");
     file.close();
   } catch (const openvdb::Exception& e) {

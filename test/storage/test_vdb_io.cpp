@@ -74,5 +74,19 @@ TEST(VdbIo, ImportChecksVoxelSizeAndTau) {
   EXPECT_THROW(import_vdb(dir / "missing.vdb", target), std::runtime_error);
 }
 
+TEST(VdbIo, MetadataIsReadWithoutTheVoxels) {
+  const auto dir = test::scratch_dir("vdb_metadata");
+  {
+    Hdf5ChunkStore source(dir / "a.h5", OpenMode::kCreate, test_metadata());
+    source.write({0, 0, 0}, make_chunk(1));
+    export_vdb(source, dir / "map.vdb");
+  }
+  const MapMetadata read = read_vdb_metadata(dir / "map.vdb");
+  EXPECT_DOUBLE_EQ(read.voxel_size_m, test_metadata().voxel_size_m);
+  EXPECT_DOUBLE_EQ(read.truncation_m, test_metadata().truncation_m);
+  EXPECT_THROW(read_vdb_metadata(dir / "missing.vdb"), std::runtime_error);
+  EXPECT_THROW(read_vdb_metadata(dir / "a.h5"), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace featsense::storage

@@ -19,8 +19,9 @@ struct VdbExportStats {
 /// Writes every chunk of `store` to `vdb_path`. Throws std::runtime_error (with the path).
 VdbExportStats export_vdb(ChunkStore& store, const std::filesystem::path& vdb_path);
 
-/// The voxel size and tau of a .vdb made by export_vdb (the other fields stay default), read
-/// without loading its voxels. Throws std::runtime_error (with the path).
+/// The voxel size and tau of a .vdb made by export_vdb (the rest of MapMetadata at its
+/// defaults), read without its voxels: what a store needs before import_vdb. Throws
+/// std::runtime_error naming the file when it cannot be read or lacks the grids or tau.
 MapMetadata read_vdb_metadata(const std::filesystem::path& vdb_path);
 
 /// Writes the voxels of a .vdb made by export_vdb into `store`, converting back to the fixed

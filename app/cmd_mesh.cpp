@@ -1,0 +1,247 @@
+// featsense mesh MAP -o MESH: marching cubes over a stored map (.h5 or .vdb), one welded mesh.
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "commands.hpp"
+#include "featsense/config/config_error.hpp"
+#include "featsense/mesh/marching_cubes.hpp"
+#include "featsense/mesh/mesh_cleanup.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+#include "featsense/storage/memory_chunk_store.hpp"
+#include "featsense/storage/vdb_io.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
+#include "json_output.hpp"
+
+namespace featsense::app {
+namespace {
+
+struct MeshOptions {
+  std::string map;
+  std::string output;
+  std::string bbox;
+  double min_weight = mesh::MeshingSettings{}.min_weight;
+  int threads = 0;
+  std::size_t cache_mb = 64;
+  bool clean = false;
+  double simplify_ratio = 1.0;
+  double min_component_area_m2 = 0.25;
+  double max_hole_perimeter_m = 1.0;
+  bool check_self_intersections = false;
+  std::optional<std::string> json_path;
+};
+
+/// "xmin,ymin,zmin,xmax,ymax,zmax" in metres.
+Eigen::AlignedBox3d parse_bbox(const std::string& text) {
+  std::istringstream in(text);
+  std::array<double, 6> v{};
+  for (size_t i = 0; i < v.size(); ++i) {
+    char comma = ',';
+    if (i > 0) in >> comma;
+    if (!(in >> v[i]) || comma != ',' || !std::isfinite(v[i])) {
+      throw config::ConfigError("--bbox: expected xmin,ymin,zmin,xmax,ymax,zmax in metres, got '" +
+                                text + "'");
+    }
+  }
+  in >> std::ws;
+  if (!in.eof()) {
+    throw config::ConfigError("--bbox: expected six numbers, got '" + text + "'");
+  }
+  const Eigen::Vector3d lo(v[0], v[1], v[2]);
+  const Eigen::Vector3d hi(v[3], v[4], v[5]);
+  if ((lo.array() >= hi.array()).any()) {
+    throw config::ConfigError("--bbox: each minimum must be below its maximum, got '" + text + "'");
+  }
+  return {lo, hi};
+}
+
+bool starts_with_bytes(const std::string& path, const std::string& magic) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(magic.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return in.gcount() == static_cast<std::streamsize>(magic.size()) && head == magic;
+}
+
+/// The map as a chunk store: an HDF5 map read in place (cache bounded), a .vdb imported into
+/// memory.
+std::unique_ptr<storage::ChunkStore> open_map(const MeshOptions& options) {
+  const std::filesystem::path path(options.map);
+  if (!std::filesystem::is_regular_file(path)) {
+    throw std::runtime_error(options.map + ": no such map file");
+  }
+  const std::string extension = viewer_export::mesh_extension(options.map);
+  if (extension == ".vdb") {
+    auto store = std::make_unique<storage::MemoryChunkStore>(storage::read_vdb_metadata(path));
+    storage::import_vdb(path, *store);
+    return store;
+  }
+  if (extension == ".h5" || starts_with_bytes(options.map, "\x89HDF")) {
+    storage::StoreSettings settings;
+    settings.cache_bytes = options.cache_mb << 20;
+    return std::make_unique<storage::Hdf5ChunkStore>(path, settings);
+  }
+  throw std::runtime_error(options.map + ": not a featsense map (expected .h5 or .vdb)");
+}
+
+void run_mesh(const MeshOptions& options) {
+  const std::string extension = viewer_export::mesh_extension(options.output);
+  if (extension != ".ply" && extension != ".glb" && extension != ".gltf" && extension != ".obj") {
+    throw config::ConfigError("-o: unknown mesh format '" + extension +
+                              "' (use .ply, .glb, .gltf or .obj)");
+  }
+  if (!(options.min_weight >= 0.0) || !std::isfinite(options.min_weight)) {
+    throw config::ConfigError("--min-weight: must be a number of measurements >= 0, got " +
+                              std::to_string(options.min_weight));
+  }
+  if (options.threads < 0) {
+    throw config::ConfigError("--threads: must be >= 0 (0 = all cores), got " +
+                              std::to_string(options.threads));
+  }
+  if (!(options.simplify_ratio > 0.0 && options.simplify_ratio <= 1.0)) {
+    throw config::ConfigError(
+        "--simplify: the fraction of triangles to keep must be in (0, 1], got " +
+        std::to_string(options.simplify_ratio));
+  }
+  if (!(options.min_component_area_m2 >= 0.0) || !(options.max_hole_perimeter_m >= 0.0)) {
+    throw config::ConfigError("--min-component-area and --max-hole must be >= 0");
+  }
+  mesh::MeshingSettings settings;
+  settings.min_weight = options.min_weight;
+  settings.threads = options.threads;
+  if (!options.bbox.empty()) settings.bbox = parse_bbox(options.bbox);
+
+  std::unique_ptr<storage::ChunkStore> store = open_map(options);
+  mesh::MeshingStats stats;
+  mesh::TriangleMesh result = mesh::extract_mesh(*store, settings, &stats);
+  store.reset();
+  if (result.triangles.empty()) {
+    throw std::runtime_error(options.map + ": no surface to mesh" +
+                             (settings.bbox ? " inside --bbox" : "") + " (" +
+                             std::to_string(stats.chunks) + " chunks, min weight " +
+                             std::to_string(options.min_weight) + ")");
+  }
+  std::optional<mesh::CleanupReport> cleanup;
+  if (options.clean || options.simplify_ratio < 1.0 || options.check_self_intersections) {
+    mesh::CleanupSettings cleaning;
+    if (options.clean) {
+      cleaning.min_component_area_m2 = options.min_component_area_m2;
+      cleaning.max_hole_perimeter_m = options.max_hole_perimeter_m;
+    }
+    cleaning.simplify_ratio = options.simplify_ratio;
+    cleaning.check_self_intersections = options.check_self_intersections;
+    cleanup = mesh::clean_mesh(result, cleaning);
+    if (result.triangles.empty()) {
+      throw std::runtime_error(options.map + ": nothing left after cleaning (" +
+                               std::to_string(cleanup->removed_components) +
+                               " small components removed)");
+    }
+  }
+  viewer_export::write_mesh(options.output, result);
+
+  const double triangles_per_s =
+      stats.seconds > 0.0 ? static_cast<double>(stats.triangles) / stats.seconds : 0.0;
+  std::printf(
+      "%s: %zu vertices, %zu triangles (meshed: %zu) from %zu chunks in %.2f s (%.2f M "
+      "triangles/s)\n",
+      options.output.c_str(), result.vertices.size(), result.triangles.size(), stats.triangles,
+      stats.chunks, stats.seconds, triangles_per_s * 1e-6);
+  if (cleanup) {
+    std::printf(
+        "cleanup: %zu -> %zu triangles, %zu small components removed, %zu non-manifold vertices "
+        "split, %zu holes filled, simplification error max %.4f m mean %.4f m, %s, %s\n",
+        cleanup->input_triangles, cleanup->output_triangles, cleanup->removed_components,
+        cleanup->non_manifold_vertices_fixed, cleanup->holes_filled,
+        cleanup->simplification_max_error_m, cleanup->simplification_mean_error_m,
+        cleanup->is_closed ? "closed" : "open", cleanup->is_manifold ? "manifold" : "not manifold");
+  }
+  if (options.json_path) {
+    nlohmann::json report = {{"map", options.map},
+                             {"output", options.output},
+                             {"vertices", result.vertices.size()},
+                             {"triangles", result.triangles.size()},
+                             {"chunks", stats.chunks},
+                             {"voxels", stats.voxels},
+                             {"seconds", stats.seconds},
+                             {"triangles_per_s", triangles_per_s},
+                             {"min_weight", options.min_weight}};
+    if (settings.bbox) {
+      report["bbox"] = {settings.bbox->min().x(), settings.bbox->min().y(),
+                        settings.bbox->min().z(), settings.bbox->max().x(),
+                        settings.bbox->max().y(), settings.bbox->max().z()};
+    }
+    if (cleanup) {
+      const mesh::CleanupReport& c = *cleanup;
+      report["cleanup"] = {{"input_triangles", c.input_triangles},
+                           {"output_triangles", c.output_triangles},
+                           {"output_vertices", c.output_vertices},
+                           {"degenerate_triangles_removed", c.degenerate_triangles_removed},
+                           {"removed_components", c.removed_components},
+                           {"removed_component_triangles", c.removed_component_triangles},
+                           {"non_manifold_vertices_fixed", c.non_manifold_vertices_fixed},
+                           {"holes_filled", c.holes_filled},
+                           {"holes_left", c.holes_left},
+                           {"simplify_ratio", options.simplify_ratio},
+                           {"simplification_max_error_m", c.simplification_max_error_m},
+                           {"simplification_mean_error_m", c.simplification_mean_error_m},
+                           {"border_edges", c.border_edges},
+                           {"is_closed", c.is_closed},
+                           {"is_manifold", c.is_manifold},
+                           {"is_valid", c.is_valid},
+                           {"seconds", c.seconds}};
+      if (options.check_self_intersections)
+        report["cleanup"]["self_intersections"] = c.self_intersections;
+    }
+    write_json(report, *options.json_path);
+  }
+}
+
+}  // namespace
+
+Command register_mesh(CLI::App& app, const CliContext& /*context*/) {
+  auto options = std::make_shared<MeshOptions>();
+  CLI::App* command = app.add_subcommand(
+      "mesh", "Marching cubes over a map (.h5 store or .vdb): one welded mesh with normals");
+  command->add_option("MAP", options->map, "The map: map.h5 (featsense map) or a .vdb export")
+      ->required();
+  command->add_option("-o,--output", options->output, "Output mesh: .ply .glb .gltf .obj")
+      ->required();
+  command->add_option("--bbox", options->bbox,
+                      "Only this box: xmin,ymin,zmin,xmax,ymax,zmax (metres, map frame)");
+  command
+      ->add_option("--min-weight", options->min_weight,
+                   "Measurements each voxel of a cube needs for it to get faces")
+      ->capture_default_str();
+  command->add_option("--threads", options->threads, "Worker threads, 0 = all cores")
+      ->capture_default_str();
+  command->add_option("--cache-mb", options->cache_mb, "Chunk cache of an .h5 map, MiB")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  command->add_flag("--clean", options->clean,
+                    "Remove small components (--min-component-area), split non-manifold "
+                    "vertices, fill holes (--max-hole)");
+  command
+      ->add_option("--min-component-area", options->min_component_area_m2,
+                   "With --clean: smaller components are removed, square metres")
+      ->capture_default_str();
+  command
+      ->add_option("--max-hole", options->max_hole_perimeter_m,
+                   "With --clean: holes with a shorter border are filled, metres (0 = none)")
+      ->capture_default_str();
+  command
+      ->add_option("--simplify", options->simplify_ratio,
+                   "Keep this fraction of the triangles (0, 1] by edge collapse; borders stay")
+      ->capture_default_str();
+  command->add_flag("--check-self-intersections", options->check_self_intersections,
+                    "Count self-intersecting triangle pairs of the result (slow on big meshes)");
+  command->add_option("--json", options->json_path, "Write the figures as JSON ('-' = stdout)");
+  return {command, [options] { run_mesh(*options); }};
+}
+
+}  // namespace featsense::app

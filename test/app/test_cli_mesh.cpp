@@ -1,0 +1,118 @@
+// featsense mesh end to end: an .h5 map and its .vdb export into meshes, the JSON figures, and
+// the messages for bad input.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "common/run_command.hpp"
+#include "common/test_data.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+#include "featsense/storage/vdb_io.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
+#include "mesh/tsdf_test_fields.hpp"
+
+namespace featsense::test {
+namespace {
+
+const Eigen::Vector3d kCentre(0.02, -0.01, 0.03);
+constexpr double kRadius = 1.0;
+
+/// A sphere of radius 1 m at 5 cm voxels (eight chunks around the origin) as map.h5 and map.vdb.
+std::filesystem::path write_sphere_map(const std::string& name) {
+  const std::filesystem::path dir = scratch_dir(name);
+  {
+    storage::Hdf5ChunkStore store(dir / "map.h5", storage::OpenMode::kCreate,
+                                  test_metadata(0.05, 0.15));
+    write_field(store, Eigen::Vector3i::Constant(-30), Eigen::Vector3i::Constant(29),
+                [](const Eigen::Vector3d& p) { return sphere_distance(p, kCentre, kRadius); });
+    storage::export_vdb(store, dir / "map.vdb");
+  }
+  return dir;
+}
+
+TEST(CliMesh, MeshesH5AndVdbMaps) {
+  const std::filesystem::path dir = write_sphere_map("cli_mesh");
+  const std::string json = (dir / "mesh.json").string();
+  CommandResult result = run_featsense("mesh " + (dir / "map.h5").string() + " -o " +
+                                       (dir / "a.ply").string() + " --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("from 8 chunks"), std::string::npos) << result.output;
+  const mesh::TriangleMesh a = viewer_export::read_mesh((dir / "a.ply").string());
+  ASSERT_GT(a.triangles.size(), 1000u);
+  for (const Eigen::Vector3f& v : a.vertices) {
+    ASSERT_LT(std::abs(sphere_distance(v.cast<double>(), kCentre, kRadius)), 0.001);
+  }
+  nlohmann::json figures;
+  std::ifstream(json) >> figures;
+  EXPECT_EQ(figures["triangles"].get<size_t>(), a.triangles.size());
+  EXPECT_EQ(figures["vertices"].get<size_t>(), a.vertices.size());
+  EXPECT_EQ(figures["chunks"].get<size_t>(), 8u);
+  EXPECT_GT(figures["triangles_per_s"].get<double>(), 0.0);
+
+  result = run_featsense("mesh " + (dir / "map.vdb").string() + " -o " + (dir / "b.glb").string() +
+                         " --threads 1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const mesh::TriangleMesh b = viewer_export::read_mesh((dir / "b.glb").string());
+  EXPECT_EQ(b.triangles.size(), a.triangles.size());
+
+  result = run_featsense("mesh " + (dir / "map.h5").string() + " -o " + (dir / "c.obj").string() +
+                         " --bbox -2,-2,-2,2,2,0.2");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const mesh::TriangleMesh c = viewer_export::read_mesh((dir / "c.obj").string());
+  EXPECT_LT(c.triangles.size(), a.triangles.size());
+  for (const Eigen::Vector3f& v : c.vertices) EXPECT_LE(v.z(), 0.2f + 1e-5f);
+
+  result = run_featsense("mesh " + (dir / "map.h5").string() + " -o " + (dir / "d.ply").string() +
+                         " --clean --simplify 0.25 --check-self-intersections --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("closed, manifold"), std::string::npos) << result.output;
+  std::ifstream(json) >> figures;
+  const nlohmann::json& cleanup = figures["cleanup"];
+  EXPECT_TRUE(cleanup["is_closed"].get<bool>());
+  EXPECT_EQ(cleanup["self_intersections"].get<size_t>(), 0u);
+  EXPECT_LT(cleanup["simplification_max_error_m"].get<double>(), 0.005);
+  const mesh::TriangleMesh d = viewer_export::read_mesh((dir / "d.ply").string());
+  EXPECT_EQ(d.triangles.size(), cleanup["output_triangles"].get<size_t>());
+  EXPECT_LT(d.triangles.size(), a.triangles.size() / 3);
+}
+
+TEST(CliMesh, ErrorsAreClear) {
+  const std::filesystem::path dir = write_sphere_map("cli_mesh_errors");
+  const std::string map = (dir / "map.h5").string();
+  const std::string out = " -o " + (dir / "out.ply").string();
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  const std::string missing = (dir / "missing.h5").string();
+  const std::string foreign = (dir / "foreign.h5").string();
+  std::ofstream(foreign) << "not a map\n";
+  const std::string text = (dir / "notes.txt").string();
+  std::ofstream(text) << "not a map either\n";
+  const std::vector<Case> cases = {
+      {"mesh " + missing + out, missing + ": no such map file"},
+      {"mesh " + foreign + out, foreign},
+      {"mesh " + text + out, "not a featsense map"},
+      {"mesh " + map + out + " --bbox 1,2,3", "--bbox: expected"},
+      {"mesh " + map + out + " --bbox 0,0,0,1,1,a", "--bbox: expected"},
+      {"mesh " + map + out + " --bbox 1,0,0,0,1,1", "minimum must be below"},
+      {"mesh " + map + out + " --min-weight -1",
+       "--min-weight: must be a number of measurements >= 0"},
+      {"mesh " + map + out + " --threads -2", "--threads: must be >= 0"},
+      {"mesh " + map + out + " --simplify 0",
+       "--simplify: the fraction of triangles to keep must be in (0, 1]"},
+      {"mesh " + map + out + " --simplify 1.5", "--simplify: the fraction"},
+      {"mesh " + map + " -o " + (dir / "out.stl").string(), "unknown mesh format '.stl'"},
+      {"mesh " + map + out + " --bbox 10,10,10,11,11,11", "no surface to mesh inside --bbox"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult result = run_featsense(c.args);
+    EXPECT_NE(result.exit_code, 0) << c.args;
+    EXPECT_NE(result.output.find(c.message), std::string::npos) << c.args << "\n" << result.output;
+  }
+}
+
+}  // namespace
+}  // namespace featsense::test
