@@ -15,6 +15,8 @@
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "json_output.hpp"
+#include "map_job.hpp"
+#include "map_outputs.hpp"
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
 #include "map_store.hpp"
@@ -25,19 +27,6 @@ namespace featsense::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct MapOptions {
-  InputOptions input;
-  std::string output;
-  std::optional<std::string> gt;
-  std::string gt_format = "auto";
-  std::optional<std::string> gt_times;
-  std::optional<std::string> backend;
-  std::optional<std::string> continue_from;
-  std::optional<std::string> start;
-  std::optional<std::string> end;
-  bool overwrite = false;
-};
 
 /// "tum" when the first data line has 8 numbers, "kitti" for 12.
 std::string detect_trajectory_format(const std::string& path) {
@@ -101,7 +90,9 @@ tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
   return {static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())};
 }
 
-void run_map(const MapOptions& options, const CliContext& context) {
+}  // namespace
+
+MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   config::Config config = context.load_config();
   if (options.backend) {
     config.map.backend = *options.backend == "cuda"  ? config::Backend::kCuda
@@ -142,6 +133,7 @@ void run_map(const MapOptions& options, const CliContext& context) {
   pipeline.range = range;
   pipeline.total_frames = info.frames;
   pipeline.quiet = context.quiet;
+  pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
   spdlog::info("mapping {} ({}) with {}", info.path, info.format, locator->description());
 
   PipelineResult result;
@@ -189,7 +181,16 @@ void run_map(const MapOptions& options, const CliContext& context) {
   if (integrator && integrator->backend_name() == "cuda") {
     summary.device_memory_bytes = integrator->memory_bytes();
   }
-  write_json(map_report_json(summary), (out / "report.json").string());
+  nlohmann::json report = map_report_json(summary);
+  if (!options.no_mesh && result.frames_mapped > 0) {
+    const MapMesh meshed = mesh_map(out / "map.h5", out);
+    report["mesh"] = mesh_json(meshed);
+    const MeshReferences references = find_mesh_references(options.input.input, options.reference);
+    if (std::optional<nlohmann::json> evaluation = evaluate_map_mesh(meshed.mesh, references)) {
+      report["eval"]["mesh"] = *evaluation;
+    }
+  }
+  write_json(report, (out / "report.json").string());
 
   if (result.frames_mapped == 0) {
     throw std::runtime_error("no scan was mapped" + (result.warnings.empty()
@@ -200,16 +201,15 @@ void run_map(const MapOptions& options, const CliContext& context) {
     throw Interrupted("interrupted after " + std::to_string(result.frames_mapped) +
                       " scans; their map, poses and report are in " + out.string());
   }
-  if (!context.quiet) {
+  if (!context.quiet && options.print_summary) {
     std::printf("%s%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
                 result.interrupted ? "interrupted: " : "", result.frames_mapped, result.wall_s,
                 result.wall_s > 0 ? static_cast<double>(result.frames_mapped) / result.wall_s : 0.0,
                 summary.backend.c_str(), summary.map_chunks, summary.map.shifts,
                 out.string().c_str());
   }
+  return {out, report};
 }
-
-}  // namespace
 
 Command register_map(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<MapOptions>();
@@ -234,6 +234,12 @@ Command register_map(CLI::App& app, const CliContext& context) {
                       "First scan to map: a frame index, or seconds after the first scan (12.5s)");
   command->add_option("--end", options->end, "Last scan to map (as --start)");
   command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
+  command->add_flag("--no-mesh", options->no_mesh, "Write the map only, no mesh.ply / mesh.glb");
+  command
+      ->add_option("--reference", options->reference,
+                   "Surveyed mesh to evaluate the map's mesh against (default: the ground "
+                   "truth of a simulated sequence)")
+      ->check(CLI::ExistingFile);
   return {command, [options, &context] { run_map(*options, context); }};
 }
 

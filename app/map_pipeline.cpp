@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "bounded_queue.hpp"
+#include "featsense/slam/preprocess/mixed_pixel_filter.hpp"
 #include "progress.hpp"
 #include "stop_signal.hpp"
 
@@ -81,10 +82,11 @@ void read_scans(slam::ScanSource& source, const FrameRange& range, BoundedQueue<
   }
 }
 
-void locate_scans(ScanLocator& locator, BoundedQueue<slam::Scan>& in,
+void locate_scans(ScanLocator& locator, bool drop_mixed, BoundedQueue<slam::Scan>& in,
                   BoundedQueue<LocatedScan>& out, PipelineState& state, PipelineResult& result) {
   while (std::optional<slam::Scan> scan = in.pop()) {
     const Clock::time_point start = Clock::now();
+    if (drop_mixed) result.mixed_pixels_dropped += slam::drop_mixed_pixels(*scan);
     std::string why;
     std::optional<LocatedScan> located = locator.locate(*scan, why);
     if (!located) {
@@ -174,7 +176,9 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, ScanLocator& locator,
     scans.close();
   });
   std::thread front_end([&] {
-    guarded(state, [&] { locate_scans(locator, scans, located, state, result); });
+    guarded(state, [&] {
+      locate_scans(locator, settings.drop_mixed_pixels, scans, located, state, result);
+    });
     if (state.stopping()) scans.abandon();
     located.close();
   });

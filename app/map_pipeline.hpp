@@ -31,6 +31,7 @@ struct PipelineSettings {
   double flush_interval_s = 30.0;
   FrameRange range;
   std::optional<size_t> total_frames;  ///< for the progress display, when known
+  bool drop_mixed_pixels = true;       ///< sensor.drop_mixed_pixels
   bool quiet = false;
 };
 
@@ -49,6 +50,7 @@ struct PipelineResult {
   size_t frames_without_pose = 0;
   size_t frames_outside_range = 0;
   size_t points = 0;  ///< rays integrated
+  size_t mixed_pixels_dropped = 0;
   size_t voxels_updated = 0;
   StageTimings timings;
   slam::Trajectory poses;  ///< the pose of every mapped scan, at its stamp

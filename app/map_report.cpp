@@ -39,6 +39,7 @@ nlohmann::json map_report_json(const MapRunSummary& summary) {
   report["backend_reason"] = summary.backend_reason;
   report["poses"] = summary.poses;
   report["points"] = run.points;
+  report["mixed_pixels_dropped"] = run.mixed_pixels_dropped;
   report["voxels_updated"] = run.voxels_updated;
   report["timings"] = {{"read", timing_json(run.timings.read_ms)},
                        {"locate", timing_json(run.timings.locate_ms)},

@@ -14,6 +14,8 @@ struct SensorConfig {
   std::string preset = "auto";
   std::optional<double> min_range_m;  ///< metres; unset: the sensor model's own limit
   std::optional<double> max_range_m;  ///< metres; unset: the sensor model's own limit
+  /// Drop veil points between a foreground edge and the surface behind it.
+  bool drop_mixed_pixels = true;
 };
 
 enum class Backend { kAuto, kCuda, kCpu };

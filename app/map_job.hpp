@@ -1,0 +1,40 @@
+#pragma once
+// One mapping run as a function, for `featsense map` and `featsense demo`.
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "cli_context.hpp"
+#include "source_options.hpp"
+
+namespace featsense::app {
+
+struct MapOptions {
+  InputOptions input;
+  std::string output;
+  std::optional<std::string> gt;
+  std::string gt_format = "auto";
+  std::optional<std::string> gt_times;
+  std::optional<std::string> backend;
+  std::optional<std::string> continue_from;
+  std::optional<std::string> start;
+  std::optional<std::string> end;
+  std::optional<std::string> reference;
+  bool overwrite = false;
+  bool no_mesh = false;
+  bool print_summary = true;  ///< the one-line summary on stdout
+};
+
+struct MapOutcome {
+  std::filesystem::path out;
+  nlohmann::json report;  ///< as written to report.json
+};
+
+/// Maps INPUT into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb, report.json). Throws
+/// ConfigError, InputError, Interrupted (after writing the outputs) or std::runtime_error.
+MapOutcome run_map(const MapOptions& options, const CliContext& context);
+
+}  // namespace featsense::app

@@ -1,0 +1,81 @@
+#include "map_outputs.hpp"
+
+#include <chrono>
+
+#include "eval_json.hpp"
+#include "featsense/mesh/compare_to_reference.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
+
+namespace featsense::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+MapMesh mesh_map(const fs::path& map_path, const fs::path& out) {
+  MapMesh result;
+  storage::StoreSettings store_settings;
+  store_settings.cache_bytes = std::size_t{128} << 20;
+  storage::Hdf5ChunkStore store(map_path, store_settings);
+  result.mesh = mesh::extract_mesh(store, mesh::MeshingSettings{}, &result.stats);
+  if (result.mesh.triangles.empty()) return result;  // nothing observed twice over: no file
+  const Clock::time_point start = Clock::now();
+  viewer_export::write_mesh((out / "mesh.ply").string(), result.mesh);
+  viewer_export::write_mesh((out / "mesh.glb").string(), result.mesh);
+  result.write_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+nlohmann::json mesh_json(const MapMesh& result) {
+  const double s = result.stats.seconds;
+  return {{"vertices", result.stats.vertices},
+          {"triangles", result.stats.triangles},
+          {"chunks", result.stats.chunks},
+          {"seconds", s},
+          {"triangles_per_s", s > 0.0 ? static_cast<double>(result.stats.triangles) / s : 0.0},
+          {"write_s", result.write_s}};
+}
+
+MeshReferences find_mesh_references(const std::string& input,
+                                    const std::optional<std::string>& user_reference) {
+  MeshReferences references;
+  if (user_reference) {
+    references.surface = fs::path(*user_reference);
+    return references;
+  }
+  const fs::path folder(input);
+  if (fs::is_directory(folder) && fs::is_regular_file(folder / "gt_mesh.ply")) {
+    references.surface = folder / "gt_mesh.ply";
+    if (fs::is_regular_file(folder / "gt_points.ply")) references.seen = folder / "gt_points.ply";
+  }
+  return references;
+}
+
+std::optional<nlohmann::json> evaluate_map_mesh(const mesh::TriangleMesh& mesh,
+                                                const MeshReferences& references) {
+  if (!references.surface || mesh.triangles.empty()) return std::nullopt;
+  const mesh::CompareSettings settings;
+  const mesh::TriangleMesh surface = viewer_export::read_mesh(references.surface->string());
+  const mesh::CompareResult against_surface = mesh::compare_to_reference(mesh, surface, settings);
+  nlohmann::json json = mesh_comparison_json(against_surface, settings);
+  json["reference_file"] = references.surface->string();
+  if (!references.seen) return json;
+
+  // Completeness counts only what the sensor saw: the points behind its returns.
+  const mesh::TriangleMesh seen = viewer_export::read_mesh(references.seen->string());
+  const mesh::CompareResult against_seen = mesh::compare_to_reference(mesh, seen, settings);
+  json["completeness"] = mesh_comparison_json(against_seen, settings)["completeness"];
+  for (auto& [key, precision] : json["precision"].items()) {
+    const double p = precision.get<double>();
+    const double c = json["completeness"][key].get<double>();
+    json["fscore"][key] = p + c > 0.0 ? 2.0 * p * c / (p + c) : 0.0;
+  }
+  json["completeness_reference"] = references.seen->string();
+  json["completeness_samples"] = against_seen.reference_samples;
+  return json;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,44 @@
+#pragma once
+// What `featsense map` makes of a finished map: the mesh (mesh.ply, mesh.glb) and, where a
+// reference is known, its evaluation.
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "featsense/mesh/marching_cubes.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
+
+namespace featsense::app {
+
+struct MapMesh {
+  mesh::TriangleMesh mesh;
+  mesh::MeshingStats stats;
+  double write_s = 0.0;
+};
+
+/// Meshes the map at `map_path` and writes `out`/mesh.ply and `out`/mesh.glb.
+MapMesh mesh_map(const std::filesystem::path& map_path, const std::filesystem::path& out);
+nlohmann::json mesh_json(const MapMesh& result);
+
+/// Where the truth of a map's surface is: accuracy is measured against `surface` (a mesh),
+/// completeness against `seen` (points of the surface the sensor saw, e.g. the simulator's
+/// gt_points.ply), or against `surface` itself when there are none.
+struct MeshReferences {
+  std::optional<std::filesystem::path> surface;
+  std::optional<std::filesystem::path> seen;
+};
+
+/// The user's reference mesh when given; else the ground truth beside a simulated sequence
+/// (gt_mesh.ply and gt_points.ply in the INPUT folder); else none.
+MeshReferences find_mesh_references(const std::string& input,
+                                    const std::optional<std::string>& user_reference);
+
+/// The `eval.mesh` section of the report (eval_json.hpp keys; completeness and F-score
+/// against `seen` where there is one), or nullopt without references.
+std::optional<nlohmann::json> evaluate_map_mesh(const mesh::TriangleMesh& mesh,
+                                                const MeshReferences& references);
+
+}  // namespace featsense::app
