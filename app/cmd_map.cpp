@@ -92,23 +92,37 @@ tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
 
 }  // namespace
 
-MapOutcome run_map(const MapOptions& options, const CliContext& context) {
+config::Config map_config(const MapOptions& options, const CliContext& context) {
   config::Config config = context.load_config();
   if (options.backend) {
     config.map.backend = *options.backend == "cuda"  ? config::Backend::kCuda
                          : *options.backend == "cpu" ? config::Backend::kCpu
                                                      : config::Backend::kAuto;
   }
+  return config;
+}
+
+MapOutcome run_map(const MapOptions& options, const CliContext& context) {
+  config::Config config = map_config(options, context);
   if (!options.gt) {
     throw config::ConfigError(
         "featsense map needs the sensor's poses: pass --gt TRAJ (a TUM file, or KITTI poses with "
         "one pose per scan); this version has no odometry front end to estimate them");
   }
-  const FrameRange range = frame_range(options);
+  frame_range(options);  // bad --start / --end fail before the recording is opened
   std::unique_ptr<slam::ScanSource> source = options.input.open(config);
-  const slam::SourceInfo& info = source->info();
+  return map_recording(*source, read_poses(options), options,
+                       find_mesh_references(options.input.input, options.reference), context);
+}
+
+MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
+                         const MapOptions& options, const MeshReferences& references,
+                         const CliContext& context) {
+  config::Config config = map_config(options, context);
+  const FrameRange range = frame_range(options);
+  const slam::SourceInfo& info = source.info();
   std::unique_ptr<ScanLocator> locator =
-      make_given_pose_locator(read_poses(options), config.odometry.deskew);
+      make_given_pose_locator(std::move(poses), config.odometry.deskew);
 
   const fs::path out(options.output);
   fs::create_directories(out);
@@ -141,7 +155,7 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   {
     const StopSignal stop_signal;
     try {
-      result = run_map_pipeline(*source, *locator, open_map, pipeline);
+      result = run_map_pipeline(source, *locator, open_map, pipeline);
     } catch (...) {
       // Whatever was integrated goes to disk before the error is reported.
       try {
@@ -185,7 +199,6 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   if (!options.no_mesh && result.frames_mapped > 0) {
     const MapMesh meshed = mesh_map(out / "map.h5", out);
     report["mesh"] = mesh_json(meshed);
-    const MeshReferences references = find_mesh_references(options.input.input, options.reference);
     if (std::optional<nlohmann::json> evaluation = evaluate_map_mesh(meshed.mesh, references)) {
       report["eval"]["mesh"] = *evaluation;
     }

@@ -27,27 +27,10 @@
 #include "featsense/slam/sim/trajectory.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "progress.hpp"
+#include "simulate_job.hpp"
 
 namespace featsense::app {
 namespace {
-
-struct SimulateOptions {
-  std::string scene;
-  std::string output_dir;
-  std::string sensor = "os1-128";
-  std::string path;
-  std::string trajectory_file;
-  int frames = 0;  ///< 0: as many as the trajectory holds
-  double rate_hz = 0.0;
-  uint64_t seed = 1;
-  double unit_scale = 1.0;
-  std::string up_axis = "auto";
-  bool no_noise = false;
-  bool no_intensity = false;
-  bool no_dropouts = false;
-  bool no_mixed_pixels = false;
-  int threads = 0;  ///< 0: all cores
-};
 
 /// A preset by name, or the sensor of an Ouster metadata JSON file (per-beam angles, beam
 /// origin offset, columns and rate of that unit).
@@ -88,8 +71,9 @@ std::unique_ptr<slam::PoseCurve> make_trajectory(const SimulateOptions& o, bool 
   return slam::make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);
 }
 
-void run_simulate(const SimulateOptions& o, const CliContext& context) {
-  context.load_config();  // validates --config / --set even though nothing here reads them
+}  // namespace
+
+PreparedSimulation::PreparedSimulation(const SimulateOptions& o) {
   if (!o.path.empty() && !o.trajectory_file.empty())
     throw std::invalid_argument("give --path or --trajectory, not both");
   const bool builtin = slam::is_builtin_scene(o.scene);
@@ -102,11 +86,9 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   slam::MeshLoadOptions load;
   load.unit_scale = o.unit_scale;
   load.up_axis = o.up_axis;
-  const slam::TriangleMesh mesh =
-      builtin ? slam::build_scene(o.scene) : slam::load_mesh(o.scene, load);
+  mesh = builtin ? slam::build_scene(o.scene) : slam::load_mesh(o.scene, load);
   slam::SimulationSettings settings;
-  const std::unique_ptr<slam::PoseCurve> trajectory =
-      make_trajectory(o, builtin, &settings.start_stamp_ns);
+  trajectory = make_trajectory(o, builtin, &settings.start_stamp_ns);
 
   settings.sensor = sensor_model(o.sensor);
   if (o.rate_hz > 0.0) settings.sensor.rate_hz = o.rate_hz;
@@ -116,12 +98,9 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   settings.measurement.dropouts = !o.no_dropouts;
   settings.measurement.mixed_pixels = !o.no_mixed_pixels;
 
-  std::optional<tbb::global_control> threads;
-  if (o.threads > 0)
-    threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
-  const slam::RayCaster caster(mesh);
-  const slam::LidarSimulator simulator(mesh, caster, *trajectory, settings);
-  const uint64_t available = simulator.frames_available();
+  caster = std::make_unique<slam::RayCaster>(mesh);
+  simulator = std::make_unique<slam::LidarSimulator>(mesh, *caster, *trajectory, settings);
+  const uint64_t available = simulator->frames_available();
   if (available == 0)
     throw std::invalid_argument("the trajectory lasts " + std::to_string(trajectory->duration_s()) +
                                 " s, shorter than one revolution");
@@ -129,9 +108,33 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
     throw std::invalid_argument("the trajectory lasts " + std::to_string(trajectory->duration_s()) +
                                 " s: room for " + std::to_string(available) + " frames, not " +
                                 std::to_string(o.frames));
-  const uint64_t frames = o.frames > 0 ? static_cast<uint64_t>(o.frames) : available;
+  frames = o.frames > 0 ? static_cast<uint64_t>(o.frames) : available;
   slam::check_trajectory_inside(*trajectory, mesh,
                                 static_cast<double>(frames) / settings.sensor.rate_hz);
+}
+
+slam::Trajectory PreparedSimulation::frame_poses() const {
+  const slam::SimulationSettings& settings = simulator->settings();
+  slam::Trajectory poses;
+  for (uint64_t i = 0; i < frames; ++i) {
+    const double t = static_cast<double>(i) / settings.sensor.rate_hz;
+    poses.push_back(settings.start_stamp_ns + static_cast<int64_t>(std::llround(t * 1e9)),
+                    trajectory->pose(t));
+  }
+  return poses;
+}
+
+void run_simulate(const SimulateOptions& o, const CliContext& context) {
+  context.load_config();  // validates --config / --set even though nothing here reads them
+  std::optional<tbb::global_control> threads;
+  if (o.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
+  const PreparedSimulation prepared(o);
+  const slam::LidarSimulator& simulator = *prepared.simulator;
+  const slam::SimulationSettings& settings = simulator.settings();
+  const slam::TriangleMesh& mesh = prepared.mesh;
+  const uint64_t frames = prepared.frames;
+  const slam::PoseCurve* trajectory = prepared.trajectory.get();
 
   slam::SimulationWriter writer(o.output_dir, settings.sensor);
   Progress progress("frames", frames, context.quiet);
@@ -162,8 +165,6 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
       median_ms, rays / median_ms * 1e-3, cpu_ms / static_cast<double>(frames),
       writer.ground_truth_points());
 }
-
-}  // namespace
 
 Command register_simulate(CLI::App& app, const CliContext& context) {
   auto o = std::make_shared<SimulateOptions>();

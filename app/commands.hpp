@@ -22,6 +22,8 @@ Command register_info(CLI::App& app, const CliContext& context);
 Command register_convert(CLI::App& app, const CliContext& context);
 /// `featsense simulate --scene NAME|MESH -o DIR`: a simulated recording with ground truth.
 Command register_simulate(CLI::App& app, const CliContext& context);
+/// `featsense demo [-o OUT] [--scene ...]`: simulate, map, mesh and evaluate a built-in scene.
+Command register_demo(CLI::App& app, const CliContext& context);
 /// `featsense bench store ...`, added to the `bench` command.
 Command register_bench_store(CLI::App& bench, const CliContext& context);
 /// `featsense map INPUT -o OUT --gt TRAJ ...`: the mapping pipeline.

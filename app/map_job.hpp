@@ -8,6 +8,9 @@
 #include <string>
 
 #include "cli_context.hpp"
+#include "featsense/slam/scan_source.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+#include "map_outputs.hpp"
 #include "source_options.hpp"
 
 namespace featsense::app {
@@ -33,8 +36,13 @@ struct MapOutcome {
   nlohmann::json report;  ///< as written to report.json
 };
 
-/// Maps INPUT into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb, report.json). Throws
-/// ConfigError, InputError, Interrupted (after writing the outputs) or std::runtime_error.
+/// Maps INPUT (opened with the run's configuration) with the poses of --gt into OUT.
 MapOutcome run_map(const MapOptions& options, const CliContext& context);
+
+/// Maps `source` with `poses` into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb, report.json).
+/// Throws ConfigError, InputError, Interrupted (after writing the outputs) or std::runtime_error.
+MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
+                         const MapOptions& options, const MeshReferences& references,
+                         const CliContext& context);
 
 }  // namespace featsense::app

@@ -56,13 +56,16 @@ MeshReferences find_mesh_references(const std::string& input,
 
 std::optional<nlohmann::json> evaluate_map_mesh(const mesh::TriangleMesh& mesh,
                                                 const MeshReferences& references) {
-  if (!references.surface || mesh.triangles.empty()) return std::nullopt;
+  // A reference may be missing: a simulation that was interrupted wrote no ground truth.
+  if (!references.surface || !fs::is_regular_file(*references.surface) || mesh.triangles.empty()) {
+    return std::nullopt;
+  }
   const mesh::CompareSettings settings;
   const mesh::TriangleMesh surface = viewer_export::read_mesh(references.surface->string());
   const mesh::CompareResult against_surface = mesh::compare_to_reference(mesh, surface, settings);
   nlohmann::json json = mesh_comparison_json(against_surface, settings);
   json["reference_file"] = references.surface->string();
-  if (!references.seen) return json;
+  if (!references.seen || !fs::is_regular_file(*references.seen)) return json;
 
   // Completeness counts only what the sensor saw: the points behind its returns.
   const mesh::TriangleMesh seen = viewer_export::read_mesh(references.seen->string());

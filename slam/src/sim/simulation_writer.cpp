@@ -93,19 +93,24 @@ void write_mesh_ply(const TriangleMesh& mesh, const std::string& path) {
 }
 
 SimulationWriter::SimulationWriter(std::string folder, config::SensorModel sensor,
-                                   double voxel_size_m)
-    : folder_(std::move(folder)), sensor_(std::move(sensor)), voxel_size_m_(voxel_size_m) {
+                                   double voxel_size_m, bool write_frames)
+    : folder_(std::move(folder)),
+      sensor_(std::move(sensor)),
+      voxel_size_m_(voxel_size_m),
+      write_frames_(write_frames) {
   std::error_code ec;
   std::filesystem::create_directories(folder_, ec);
   if (ec) throw WriteError(folder_ + ": cannot create the folder: " + ec.message());
 }
 
 void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor) {
-  char name[64];
-  std::snprintf(name, sizeof name, "frame_%06zu.pcd", files_.size());
-  write_scan_pcd(frame.scan, (std::filesystem::path(folder_) / name).string());
-  files_.push_back(name);
-  stamps_ns_.push_back(frame.scan.stamp_ns);
+  if (write_frames_) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%06zu.pcd", files_.size());
+    write_scan_pcd(frame.scan, (std::filesystem::path(folder_) / name).string());
+    files_.push_back(name);
+    stamps_ns_.push_back(frame.scan.stamp_ns);
+  }
   trajectory_.push_back(frame.scan.stamp_ns, T_map_sensor);
   for (const Eigen::Vector3f& p : frame.surface_points_m) {
     if (insert_voxel(voxel_key(p, voxel_size_m_))) points_.push_back(p);
@@ -134,6 +139,10 @@ bool SimulationWriter::insert_voxel(uint64_t key) {
 
 void SimulationWriter::finish(const TriangleMesh& mesh) {
   const std::filesystem::path dir(folder_);
+  write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
+  write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());
+  write_points_ply(points_, (dir / "gt_points.ply").string());
+  if (!write_frames_) return;
   cloud::SequenceFile sequence;
   sequence.sensor = sensor_;
   sequence.sensor_is_preset = is_unchanged_preset(sensor_);
@@ -143,9 +152,6 @@ void SimulationWriter::finish(const TriangleMesh& mesh) {
   std::ofstream yaml = open_for_writing(yaml_path);
   yaml << cloud::format_sequence_yaml(sequence);
   close_checked(yaml, yaml_path);
-  write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
-  write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());
-  write_points_ply(points_, (dir / "gt_points.ply").string());
 }
 
 }  // namespace featsense::slam

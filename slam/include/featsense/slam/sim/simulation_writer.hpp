@@ -23,12 +23,14 @@ namespace featsense::slam {
 
 class SimulationWriter {
  public:
-  /// Creates `folder` (and parents). Throws WriteError naming it when that fails.
-  SimulationWriter(std::string folder, config::SensorModel sensor, double voxel_size_m = 0.02);
+  /// Creates `folder` (and parents). Throws WriteError naming it when that fails. Without
+  /// `write_frames` only the ground truth is written (the frames went straight to a consumer).
+  SimulationWriter(std::string folder, config::SensorModel sensor, double voxel_size_m = 0.02,
+                   bool write_frames = true);
 
   /// Writes the frame's PCD and records its stamp, ground-truth pose and surface points.
   void add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor);
-  /// Writes sequence.yaml, gt_trajectory.tum, gt_mesh.ply and gt_points.ply.
+  /// Writes gt_trajectory.tum, gt_mesh.ply, gt_points.ply and (with frames) sequence.yaml.
   void finish(const TriangleMesh& mesh);
 
   size_t ground_truth_points() const { return points_.size(); }
@@ -40,6 +42,7 @@ class SimulationWriter {
   std::string folder_;
   config::SensorModel sensor_;
   double voxel_size_m_;
+  bool write_frames_;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
   Trajectory trajectory_;  ///< the true pose of each frame at its stamp
