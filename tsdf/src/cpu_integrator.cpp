@@ -9,8 +9,8 @@
 #include <atomic>
 #include <memory>
 
+#include "cpu_ray_walk.hpp"
 #include "featsense/tsdf/integrator.hpp"
-#include "ray_marcher.hpp"
 
 namespace featsense::tsdf {
 namespace {
@@ -22,6 +22,17 @@ uint32_t atomic_min(std::atomic<uint32_t>& slot, uint32_t value) {
          !slot.compare_exchange_weak(current, value, std::memory_order_relaxed)) {
   }
   return current;
+}
+
+/// tsdf::fuse, without its division where the result is known: a voxel never observed, or
+/// one that already holds the scan's value (most of the carved free space), keeps the value.
+Voxel fuse_voxel(Voxel map, int32_t value, uint32_t weight, uint32_t max_weight_fixed) {
+  if (weight != 0u && (map.weight == 0u || map.value == value)) {
+    const uint32_t total = map.weight + weight;
+    return {static_cast<int16_t>(value),
+            static_cast<uint16_t>(total < max_weight_fixed ? total : max_weight_fixed)};
+  }
+  return fuse(map, value, weight, max_weight_fixed);
 }
 
 class CpuIntegrator final : public Integrator {
@@ -71,8 +82,8 @@ class CpuIntegrator final : public Integrator {
                         };
                         for (size_t k = range.begin(); k != range.end(); ++k) {
                           const size_t i = kept[k];
-                          detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params,
-                                            propose);
+                          detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params,
+                                           propose);
                         }
                       });
 
@@ -134,7 +145,7 @@ class CpuIntegrator final : public Integrator {
                             candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
                             const int32_t value = candidate_value(key);
                             map_[index] =
-                                pack(tsdf::fuse(unpack(map_[index]), value,
+                                pack(fuse_voxel(unpack(map_[index]), value,
                                                 candidate_weight(value, falloff), max_weight));
                             ++local_updated;
                           }
