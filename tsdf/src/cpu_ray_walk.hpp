@@ -11,6 +11,8 @@
 // - free space (d >= tau) needs no division: d / tau >= 1 there, so the clamped value is
 //   exactly kValueScale, and there is no interpolation.
 
+#include <type_traits>
+
 #include "ray_marcher.hpp"
 
 namespace featsense::tsdf::detail {
@@ -119,24 +121,34 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
         }
       }
     }
-    int axis = 0;
-    if (t_next[1] < t_next[axis]) axis = 1;
-    if (t_next[2] < t_next[axis]) axis = 2;
-    t = t_next[axis];
-    t_next[axis] += t_delta[axis];
-    const int32_t s = step[axis];
-    voxel[axis] += s;
-    offset[axis] += s;
-    term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
-    local[axis] += s;
-    if (local[axis] == kBrickSize || local[axis] < 0) {
-      local[axis] -= s * kBrickSize;
-      brick[axis] += s;
-      if (brick[axis] == bricks[axis]) brick[axis] = 0;
-      if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
-      index = static_cast<int64_t>(linear());
+    // Step into the neighbour across the nearest voxel face (march_ray's rule). Each axis has
+    // its own code, so that every array above is indexed by a constant and lives in registers.
+    const auto step_along = [&](auto axis_constant) {
+      constexpr int axis = decltype(axis_constant)::value;
+      t = t_next[axis];
+      t_next[axis] += t_delta[axis];
+      const int32_t s = step[axis];
+      voxel[axis] += s;
+      offset[axis] += s;
+      term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
+      local[axis] += s;
+      if (local[axis] == kBrickSize || local[axis] < 0) {
+        local[axis] -= s * kBrickSize;
+        brick[axis] += s;
+        if (brick[axis] == bricks[axis]) brick[axis] = 0;
+        if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+        index = static_cast<int64_t>(linear());
+      } else {
+        index += s * local_stride[axis];
+      }
+    };
+    const bool y_first = t_next[1] < t_next[0];
+    if (t_next[2] < (y_first ? t_next[1] : t_next[0])) {
+      step_along(std::integral_constant<int, 2>());
+    } else if (y_first) {
+      step_along(std::integral_constant<int, 1>());
     } else {
-      index += s * local_stride[axis];
+      step_along(std::integral_constant<int, 0>());
     }
   }
 }
