@@ -91,6 +91,21 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
   const int64_t local_stride[3] = {1, kBrickSize, kBrickSize * kBrickSize};
   int64_t index = static_cast<int64_t>(linear());
 
+  // map.linear for a voxel known to lie in the map, without its three divisions: the brick's
+  // offset from the map's lowest brick is below the brick count, so wrapping it is one
+  // comparison (the map's lowest corner is a whole brick, so the place in the brick is too).
+  const Index3 lowest_slot = map.wrapped_brick(map.origin);
+  const auto linear_of_contained = [&](Index3 g) {
+    const auto slot = [](int32_t relative, int32_t lowest, int32_t count) {
+      const int32_t b = lowest + (relative >> kBrickShift);
+      return b >= count ? b - count : b;
+    };
+    const Index3 r{g.x - map.origin.x, g.y - map.origin.y, g.z - map.origin.z};
+    return map.linear_from({slot(r.x, lowest_slot.x, nb.x), slot(r.y, lowest_slot.y, nb.y),
+                            slot(r.z, lowest_slot.z, nb.z)},
+                           LocalMapGeometry::local_in_brick(r));
+  };
+
   const float tau = params.truncation_m;
   float t = 0.0f;
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
@@ -115,8 +130,8 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
             const float shift = static_cast<float>(k) * vs;
             const Index3 above = map.voxel_of(centre + shift * across);
             const Index3 below = map.voxel_of(centre - shift * across);
-            if (map.contains(above)) visit(map.linear(above), value, true);
-            if (map.contains(below)) visit(map.linear(below), value, true);
+            if (map.contains(above)) visit(linear_of_contained(above), value, true);
+            if (map.contains(below)) visit(linear_of_contained(below), value, true);
           }
         }
       }
