@@ -121,26 +121,38 @@ class CpuIntegrator final : public Integrator {
       for (size_t i = 0; i < rays.size(); ++i) kept.push_back(static_cast<uint32_t>(i));
       return kept;
     }
+    // The storage index of each end point's voxel, or none for points outside the map.
+    constexpr size_t kOutside = std::numeric_limits<size_t>::max();
+    std::vector<size_t> end_voxel(rays.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& range) {
                         for (size_t i = range.begin(); i != range.end(); ++i) {
                           Index3 v;
-                          if (geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
-                            atomic_min(candidates_[geometry_.linear(v)], static_cast<uint32_t>(i));
+                          end_voxel[i] = geometry_.voxel_in_map(rays.endpoints_m[i], v)
+                                             ? geometry_.linear(v)
+                                             : kOutside;
+                          if (end_voxel[i] != kOutside) {
+                            atomic_min(candidates_[end_voxel[i]], static_cast<uint32_t>(i));
                           }
                         }
                       });
+    // A point is the first of its voxel when the voxel holds its index. Only that point resets
+    // the voxel; the others of the voxel compare with their own index, which it never holds.
+    std::vector<uint8_t> keep(rays.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                        for (size_t i = range.begin(); i != range.end(); ++i) {
+                          if (end_voxel[i] == kOutside) {
+                            keep[i] = 1;
+                            continue;
+                          }
+                          std::atomic<uint32_t>& slot = candidates_[end_voxel[i]];
+                          keep[i] = slot.load(std::memory_order_relaxed) == i ? 1 : 0;
+                          if (keep[i] != 0) slot.store(kEmptyCandidate, std::memory_order_relaxed);
+                        }
+                      });
     for (size_t i = 0; i < rays.size(); ++i) {
-      Index3 v;
-      if (!geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
-        kept.push_back(static_cast<uint32_t>(i));
-        continue;
-      }
-      std::atomic<uint32_t>& slot = candidates_[geometry_.linear(v)];
-      if (slot.load(std::memory_order_relaxed) == i) {
-        kept.push_back(static_cast<uint32_t>(i));
-        slot.store(kEmptyCandidate, std::memory_order_relaxed);
-      }
+      if (keep[i] != 0) kept.push_back(static_cast<uint32_t>(i));
     }
     return kept;
   }
