@@ -8,6 +8,7 @@
 //   speed work (commit 51f32ca), so a change of the shared definitions shows up as well.
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdio>
@@ -176,6 +177,24 @@ TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
   s.interpolation_slope = os1_interpolation_slope();
   EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), box_room_rays(2, false)),
             0x4761511e2fed3bc0ull);
+}
+
+TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
+  // The CPU integrator shares the map out among sectors by its thread count: one thread
+  // (four sectors) and seven (28 sectors, more candidates handed between them) must give the
+  // same map as the brute-force integrator.
+  TsdfSettings s;
+  s.map_size_m = {16.0f, 16.0f, 6.0f};
+  s.interpolation_slope = os1_interpolation_slope();
+  const std::vector<RayBatch> scans = box_room_rays(2, false);
+  for (const int threads : {1, 7}) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans),
+                0xb30418ff7c191ab9ull)
+          << threads << " threads";
+    });
+  }
 }
 
 TEST(CpuIntegratorExact, RepeatedScansReachTheWeightCapWithOneOrigin) {
