@@ -1,5 +1,6 @@
-// The reference integrator: rays in parallel with TBB, the per-scan minimum by a
-// compare-exchange loop, fusion over the voxels this scan touched.
+// The reference integrator: rays in parallel with TBB, each thread writing the per-scan
+// minimum of the voxels of its own sectors around the sensor (plain stores, no
+// compare-exchange), fusion over the voxels this scan touched.
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
