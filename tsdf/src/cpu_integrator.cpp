@@ -1,17 +1,21 @@
-// The reference integrator: rays in parallel with TBB, the per-scan minimum by a
-// compare-exchange loop, fusion over the voxels this scan touched.
+// The reference integrator: rays in parallel with TBB, each thread writing the per-scan
+// minimum of the voxels of its own sectors around the sensor (plain stores, no
+// compare-exchange), fusion over the voxels this scan touched.
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <limits>
 #include <memory>
 
 #include "brick_checks.hpp"
+#include "cpu_ray_walk.hpp"
 #include "featsense/tsdf/integrator.hpp"
-#include "ray_marcher.hpp"
 
 namespace featsense::tsdf {
 namespace {
@@ -25,6 +29,17 @@ uint32_t atomic_min(std::atomic<uint32_t>& slot, uint32_t value) {
   return current;
 }
 
+/// tsdf::fuse, without its division where the result is known: a voxel never observed, or
+/// one that already holds the scan's value (most of the carved free space), keeps the value.
+Voxel fuse_voxel(Voxel map, int32_t value, uint32_t weight, uint32_t max_weight_fixed) {
+  if (weight != 0u && (map.weight == 0u || map.value == value)) {
+    const uint32_t total = map.weight + weight;
+    return {static_cast<int16_t>(value),
+            static_cast<uint16_t>(total < max_weight_fixed ? total : max_weight_fixed)};
+  }
+  return fuse(map, value, weight, max_weight_fixed);
+}
+
 class CpuIntegrator final : public Integrator {
  public:
   CpuIntegrator(const TsdfSettings& settings, Vec3 centre_m)
@@ -32,20 +47,22 @@ class CpuIntegrator final : public Integrator {
         geometry_(centred_geometry(settings, centre_m)),
         map_(geometry_.voxel_count(), kUnobservedVoxel),
         candidates_(new std::atomic<uint32_t>[geometry_.voxel_count()]),
-        brick_flags_(new std::atomic<uint8_t>[geometry_.voxel_count() / kBrickVoxels]) {
+        brick_owner_(geometry_.voxel_count() / kBrickVoxels, 0),
+        brick_listed_(geometry_.voxel_count() / kBrickVoxels, 0),
+        occupancy_(geometry_.voxel_count() / 64, 0),
+        parts_(sector_count()) {
     for (size_t i = 0; i < geometry_.voxel_count(); ++i) {
       candidates_[i].store(kEmptyCandidate, std::memory_order_relaxed);
     }
-    for (size_t b = 0; b < geometry_.voxel_count() / kBrickVoxels; ++b) {
-      brick_flags_[b].store(0, std::memory_order_relaxed);
-    }
+    for (Part& part : parts_) part.handed_over.resize(parts_.size());
   }
 
   std::string backend_name() const override { return "cpu"; }
   const LocalMapGeometry& geometry() const override { return geometry_; }
   std::vector<uint32_t> download() const override { return map_; }
   size_t memory_bytes() const override {
-    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + geometry_.voxel_count() / kBrickVoxels;
+    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + geometry_.voxel_count() / 8 +
+           2 * geometry_.voxel_count() / kBrickVoxels;
   }
 
   void read_bricks(const std::vector<Index3>& bricks,
@@ -74,35 +91,33 @@ class CpuIntegrator final : public Integrator {
   IntegrationStats integrate(const RayBatch& rays) override {
     check_ray_batch(rays);
     const std::vector<uint32_t> kept = rays_to_march(rays);
+    if (kept.empty()) return {};
     detail::RayMarchParams params;
     params.truncation_m = settings_.truncation_m;
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
 
-    for (auto& list : touched_) list.clear();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, kept.size(), 64),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                        std::vector<uint32_t>& touched = touched_.local();
-                        const auto propose = [&](size_t index, int32_t value, bool interpolated) {
-                          const uint32_t key = make_candidate(value, interpolated);
-                          if (atomic_min(candidates_[index], key) != kEmptyCandidate) return;
-                          // A voxel's first candidate: list its brick once, for the fusion.
-                          const size_t brick = index / kBrickVoxels;
-                          if (brick_flags_[brick].load(std::memory_order_relaxed) == 0 &&
-                              brick_flags_[brick].exchange(1, std::memory_order_relaxed) == 0) {
-                            touched.push_back(static_cast<uint32_t>(brick));
-                          }
-                        };
-                        for (size_t k = range.begin(); k != range.end(); ++k) {
-                          const size_t i = kept[k];
-                          detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params,
-                                            propose);
-                        }
-                      });
+    // The map is cut into sectors around the sensor, each brick column owned by one; every
+    // ray is walked by the sector of its end point, which writes the voxels it owns directly
+    // and hands the few others (near the sensor, where sectors are narrow) to their owners.
+    // Nobody ever writes a voxel another task may write at the same time, so there is no
+    // locked instruction (a compare-exchange per voxel cost more than the rest of the visit).
+    const Vec3 centre = rays.origin(kept.front());
+    assign_brick_owners(centre);
+    const std::vector<std::vector<uint32_t>> rays_of = rays_by_sector(rays, kept, centre);
+    for (Part& part : parts_) {
+      part.touched.clear();
+      for (auto& list : part.handed_over) list.clear();
+    }
+    tbb::parallel_for(
+        size_t{0}, parts_.size(), [&](size_t p) { march_sector(p, rays, rays_of[p], params); },
+        tbb::simple_partitioner());
+    tbb::parallel_for(
+        size_t{0}, parts_.size(), [&](size_t p) { take_over(p); }, tbb::simple_partitioner());
 
     IntegrationStats stats;
     stats.rays = kept.size();
-    for (const std::vector<uint32_t>& bricks : touched_) stats.voxels_updated += fuse(bricks);
+    for (const Part& part : parts_) stats.voxels_updated += fuse(part.touched);
     return stats;
   }
 
@@ -119,6 +134,20 @@ class CpuIntegrator final : public Integrator {
                       });
   }
 
+  static constexpr int kSectorsPerThread = 4;
+  static constexpr size_t kWordsPerBrick = kBrickVoxels / 64;
+
+  /// A candidate for a voxel of another sector.
+  struct HandedOver {
+    size_t index;
+    uint32_t key;
+  };
+  /// What one sector's task collects while walking its rays.
+  struct Part {
+    std::vector<uint32_t> touched;                     ///< bricks listed for the fusion
+    std::vector<std::vector<HandedOver>> handed_over;  ///< by owning sector
+  };
+
   /// Indices of the rays to march: all, or the first end point of each voxel of the local
   /// map plus every end point outside it (the rule of TsdfSettings::reduce_points_per_voxel,
   /// computed as the CUDA backend does: a minimum of point indices per voxel).
@@ -129,26 +158,38 @@ class CpuIntegrator final : public Integrator {
       for (size_t i = 0; i < rays.size(); ++i) kept.push_back(static_cast<uint32_t>(i));
       return kept;
     }
+    // The storage index of each end point's voxel, or none for points outside the map.
+    constexpr size_t kOutside = std::numeric_limits<size_t>::max();
+    std::vector<size_t> end_voxel(rays.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& range) {
                         for (size_t i = range.begin(); i != range.end(); ++i) {
                           Index3 v;
-                          if (geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
-                            atomic_min(candidates_[geometry_.linear(v)], static_cast<uint32_t>(i));
+                          end_voxel[i] = geometry_.voxel_in_map(rays.endpoints_m[i], v)
+                                             ? geometry_.linear(v)
+                                             : kOutside;
+                          if (end_voxel[i] != kOutside) {
+                            atomic_min(candidates_[end_voxel[i]], static_cast<uint32_t>(i));
                           }
                         }
                       });
+    // A point is the first of its voxel when the voxel holds its index. Only that point resets
+    // the voxel; the others of the voxel compare with their own index, which it never holds.
+    std::vector<uint8_t> keep(rays.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                        for (size_t i = range.begin(); i != range.end(); ++i) {
+                          if (end_voxel[i] == kOutside) {
+                            keep[i] = 1;
+                            continue;
+                          }
+                          std::atomic<uint32_t>& slot = candidates_[end_voxel[i]];
+                          keep[i] = slot.load(std::memory_order_relaxed) == i ? 1 : 0;
+                          if (keep[i] != 0) slot.store(kEmptyCandidate, std::memory_order_relaxed);
+                        }
+                      });
     for (size_t i = 0; i < rays.size(); ++i) {
-      Index3 v;
-      if (!geometry_.voxel_in_map(rays.endpoints_m[i], v)) {
-        kept.push_back(static_cast<uint32_t>(i));
-        continue;
-      }
-      std::atomic<uint32_t>& slot = candidates_[geometry_.linear(v)];
-      if (slot.load(std::memory_order_relaxed) == i) {
-        kept.push_back(static_cast<uint32_t>(i));
-        slot.store(kEmptyCandidate, std::memory_order_relaxed);
-      }
+      if (keep[i] != 0) kept.push_back(static_cast<uint32_t>(i));
     }
     return kept;
   }
@@ -163,30 +204,143 @@ class CpuIntegrator final : public Integrator {
                       [&](const tbb::blocked_range<size_t>& range) {
                         size_t local_updated = 0;
                         for (size_t k = range.begin(); k != range.end(); ++k) {
-                          const size_t first = static_cast<size_t>(bricks[k]) * kBrickVoxels;
-                          for (size_t index = first; index < first + kBrickVoxels; ++index) {
-                            const uint32_t key = candidates_[index].load(std::memory_order_relaxed);
-                            if (key == kEmptyCandidate) continue;
-                            candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
-                            const int32_t value = candidate_value(key);
-                            map_[index] =
-                                pack(tsdf::fuse(unpack(map_[index]), value,
-                                                candidate_weight(value, falloff), max_weight));
-                            ++local_updated;
-                          }
-                          brick_flags_[bricks[k]].store(0, std::memory_order_relaxed);
+                          local_updated += fuse_brick(bricks[k], falloff, max_weight);
+                          brick_listed_[bricks[k]] = 0;
                         }
                         updated += local_updated;
                       });
     return updated.load();
   }
 
+  /// Fuses the candidates of one brick, visiting only the voxels its occupancy bits name
+  /// (testing every voxel for a candidate mispredicts a branch on most partly touched
+  /// bricks); resets them and returns how many there were.
+  size_t fuse_brick(size_t brick, int32_t falloff, uint32_t max_weight) {
+    size_t updated = 0;
+    for (size_t word = brick * kWordsPerBrick; word < (brick + 1) * kWordsPerBrick; ++word) {
+      uint64_t bits = occupancy_[word];
+      occupancy_[word] = 0;
+      for (; bits != 0; bits &= bits - 1) {
+        const size_t index = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
+        const int32_t value = candidate_value(candidates_[index].load(std::memory_order_relaxed));
+        candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
+        map_[index] = pack(
+            fuse_voxel(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
+        ++updated;
+      }
+    }
+    return updated;
+  }
+
+  /// Sectors per thread: enough for the threads to balance their load, few enough that
+  /// little is handed over between sectors near the sensor.
+  static size_t sector_count() {
+    const int threads = tbb::this_task_arena::max_concurrency();
+    return static_cast<size_t>(std::clamp(kSectorsPerThread * threads, 4, 255));
+  }
+
+  /// The sector of map-frame direction (dx, dy) from the sensor: a monotonic stand-in for
+  /// atan2 (the diamond angle, in [0, 4)), cut into equal parts.
+  size_t sector_of(float dx, float dy) const {
+    const float sum = std::fabs(dx) + std::fabs(dy);
+    if (!(sum > 0.0f && sum < std::numeric_limits<float>::infinity())) return 0;
+    float angle;
+    if (dy >= 0.0f) {
+      angle = dx >= 0.0f ? dy / sum : 1.0f - dx / sum;
+    } else {
+      angle = dx < 0.0f ? 2.0f - dy / sum : 3.0f + dx / sum;
+    }
+    const auto sector = static_cast<size_t>(angle * static_cast<float>(parts_.size()) / 4.0f);
+    return std::min(sector, parts_.size() - 1);
+  }
+
+  /// Gives each brick column of the map to the sector of its centre seen from `centre`.
+  void assign_brick_owners(Vec3 centre) {
+    const Index3 nb = geometry_.bricks();
+    const float brick_m = static_cast<float>(kBrickSize) * geometry_.voxel_size_m;
+    const size_t layer = static_cast<size_t>(nb.x) * static_cast<size_t>(nb.y);
+    for (int32_t j = 0; j < nb.y; ++j) {
+      for (int32_t i = 0; i < nb.x; ++i) {
+        const int32_t bx = geometry_.origin.x / kBrickSize + i;  // global brick coordinates
+        const int32_t by = geometry_.origin.y / kBrickSize + j;
+        const auto owner =
+            static_cast<uint8_t>(sector_of((static_cast<float>(bx) + 0.5f) * brick_m - centre.x,
+                                           (static_cast<float>(by) + 0.5f) * brick_m - centre.y));
+        const size_t column = static_cast<size_t>(wrap_index(bx, nb.x)) +
+                              static_cast<size_t>(nb.x) * static_cast<size_t>(wrap_index(by, nb.y));
+        for (int32_t z = 0; z < nb.z; ++z)
+          brick_owner_[column + layer * static_cast<size_t>(z)] = owner;
+      }
+    }
+  }
+
+  /// The rays to march, by the sector of their end point.
+  std::vector<std::vector<uint32_t>> rays_by_sector(const RayBatch& rays,
+                                                    const std::vector<uint32_t>& kept,
+                                                    Vec3 centre) const {
+    std::vector<std::vector<uint32_t>> rays_of(parts_.size());
+    for (const uint32_t i : kept) {
+      const Vec3 e = rays.endpoints_m[i];
+      rays_of[sector_of(e.x - centre.x, e.y - centre.y)].push_back(i);
+    }
+    return rays_of;
+  }
+
+  /// Sector p walks its rays: candidates for its own voxels are written, the others handed over.
+  void march_sector(size_t p, const RayBatch& rays, const std::vector<uint32_t>& ray_ids,
+                    const detail::RayMarchParams& params) {
+    Part& part = parts_[p];
+    const auto propose = [&](size_t index, int32_t value, bool interpolated) {
+      const uint32_t key = make_candidate(value, interpolated);
+      // Candidates only fall during a scan: one at or below this key already makes it moot.
+      // (Near the sensor, where every ray passes, that is nearly every visit.)
+      const uint32_t current = candidates_[index].load(std::memory_order_relaxed);
+      if (key >= current) return;
+      const uint8_t owner = brick_owner_[index / kBrickVoxels];
+      if (owner == p) {
+        lower(part, index, key, current);
+      } else {
+        part.handed_over[owner].push_back({index, key});
+      }
+    };
+    for (const uint32_t i : ray_ids) {
+      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params, propose);
+    }
+  }
+
+  /// Sector p applies what the other sectors handed over to it.
+  void take_over(size_t p) {
+    for (const Part& from : parts_) {
+      for (const HandedOver& h : from.handed_over[p]) {
+        const uint32_t current = candidates_[h.index].load(std::memory_order_relaxed);
+        if (h.key < current) lower(parts_[p], h.index, h.key, current);
+      }
+    }
+  }
+
+  /// Writes a smaller candidate to a voxel of `part`'s sector; the brick of a voxel's first
+  /// candidate is listed once, for the fusion.
+  void lower(Part& part, size_t index, uint32_t key, uint32_t current) {
+    candidates_[index].store(key, std::memory_order_relaxed);
+    if (current != kEmptyCandidate) return;
+    occupancy_[index / 64] |= uint64_t{1} << (index % 64);
+    const size_t brick = index / kBrickVoxels;
+    if (brick_listed_[brick] == 0) {
+      brick_listed_[brick] = 1;
+      part.touched.push_back(static_cast<uint32_t>(brick));
+    }
+  }
+
   TsdfSettings settings_;
   LocalMapGeometry geometry_;
   std::vector<uint32_t> map_;
+  /// The scan's candidates. Atomic only so that a sector may read a voxel another one writes
+  /// (to drop moot candidates); every access is relaxed, plain loads and stores.
   std::unique_ptr<std::atomic<uint32_t>[]> candidates_;
-  std::unique_ptr<std::atomic<uint8_t>[]> brick_flags_;             ///< 1 while a brick is listed
-  tbb::enumerable_thread_specific<std::vector<uint32_t>> touched_;  ///< bricks, per thread
+  std::vector<uint8_t> brick_owner_;   ///< the sector that writes each brick, this scan
+  std::vector<uint8_t> brick_listed_;  ///< 1 while a brick is listed for the fusion
+  std::vector<uint64_t> occupancy_;    ///< a bit per voxel that has a candidate
+  std::vector<Part> parts_;            ///< one per sector
 };
 
 }  // namespace

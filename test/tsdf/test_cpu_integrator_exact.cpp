@@ -1,0 +1,225 @@
+// The CPU integrator's exact output, bit for bit. The CUDA backend is checked against the CPU
+// integrator on the GPU machine, so any change to the CPU map (a voxel value, a weight, a
+// count) breaks that parity even where no test here would notice. Two checks per case:
+// - against a brute-force integrator written here (one thread, a plain minimum, fusion of a
+//   list of touched voxels), which shares only ray_marcher.hpp and voxel.hpp, the definitions
+//   the CUDA kernels compile too;
+// - against hashes of the map and stats recorded with the integrator as it was before its
+//   speed work (commit 51f32ca), so a change of the shared definitions shows up as well.
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <unordered_set>
+
+#include "analytic_rays.hpp"
+#include "featsense/slam/sim/box_room_source.hpp"
+#include "ray_marcher.hpp"
+#include "tsdf_test_support.hpp"
+
+namespace featsense::tsdf {
+namespace {
+
+/// The straightforward integrator: the rules of tsdf/README.md with nothing clever.
+class BruteForceIntegrator {
+ public:
+  BruteForceIntegrator(const TsdfSettings& settings, Vec3 centre_m)
+      : settings_(settings),
+        geometry_(centred_geometry(settings, centre_m)),
+        map_(geometry_.voxel_count(), kUnobservedVoxel),
+        candidates_(geometry_.voxel_count(), kEmptyCandidate) {}
+
+  IntegrationStats integrate(const RayBatch& rays) {
+    detail::RayMarchParams params;
+    params.truncation_m = settings_.truncation_m;
+    params.interpolation_slope = settings_.interpolation_slope;
+    params.up = rays.up;
+    IntegrationStats stats;
+    std::unordered_set<size_t> end_voxels;  // voxels that already have their first point
+    std::vector<size_t> touched;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      Index3 v;
+      if (settings_.reduce_points_per_voxel && geometry_.voxel_in_map(rays.endpoints_m[i], v) &&
+          !end_voxels.insert(geometry_.linear(v)).second) {
+        continue;
+      }
+      ++stats.rays;
+      detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params,
+                        [&](size_t index, int32_t value, bool interpolated) {
+                          if (candidates_[index] == kEmptyCandidate) touched.push_back(index);
+                          candidates_[index] =
+                              std::min(candidates_[index], make_candidate(value, interpolated));
+                        });
+    }
+    for (const size_t index : touched) {
+      const int32_t value = candidate_value(candidates_[index]);
+      const uint32_t weight = candidate_weight(value, settings_.falloff_start_fixed());
+      map_[index] = pack(fuse(unpack(map_[index]), value, weight, settings_.max_weight_fixed()));
+      candidates_[index] = kEmptyCandidate;
+    }
+    stats.voxels_updated = touched.size();
+    return stats;
+  }
+
+  const std::vector<uint32_t>& map() const { return map_; }
+
+ private:
+  TsdfSettings settings_;
+  LocalMapGeometry geometry_;
+  std::vector<uint32_t> map_;
+  std::vector<uint32_t> candidates_;
+};
+
+/// FNV-1a over 32-bit words.
+uint64_t fnv1a(uint64_t hash, uint64_t word) {
+  hash ^= word;
+  return hash * 0x100000001b3ull;
+}
+
+/// Scans of the box room with per-point origins (deskewed), as `featsense bench tsdf` builds
+/// them; `outdoor` is its 120 x 80 m yard open to the sky.
+std::vector<RayBatch> box_room_rays(int frames, bool outdoor) {
+  slam::BoxRoomSettings settings = slam::default_box_room();
+  settings.frames = frames;
+  settings.velocity_mps = Eigen::Vector3d(1.5, 0.5, 0.1);
+  if (outdoor) {
+    settings.room_min_m = Eigen::Vector3d(-60, -40, 0);
+    settings.room_max_m = Eigen::Vector3d(60, 40, 1e4);
+    settings.velocity_mps = Eigen::Vector3d(5, 0.3, 0);
+  }
+  auto source = slam::make_box_room_source(settings);
+  std::vector<RayBatch> batches;
+  int frame = 0;
+  while (auto scan = source->next()) {
+    RayBatch rays;
+    for (size_t i = 0; i < scan->size(); ++i) {
+      if (!scan->valid[i]) continue;
+      const double t = frame / settings.sensor.rate_hz + scan->time_offset_s[i];
+      const Eigen::Isometry3d pose = slam::box_room_pose(settings, t);
+      const Eigen::Vector3d p = pose * scan->xyz[i].cast<double>();
+      rays.endpoints_m.push_back(test::make_vec(p.x(), p.y(), p.z()));
+      const Eigen::Vector3d o = pose.translation();
+      rays.origins_m.push_back(test::make_vec(o.x(), o.y(), o.z()));
+    }
+    batches.push_back(std::move(rays));
+    ++frame;
+  }
+  return batches;
+}
+
+/// Integrates `scans` with the CPU integrator and the brute-force one, expects the same map
+/// and stats after every scan, and returns a hash of the CPU integrator's maps and stats.
+uint64_t expect_same_as_brute_force(const TsdfSettings& settings, Vec3 centre_m,
+                                    const std::vector<RayBatch>& scans) {
+  auto cpu = make_cpu_integrator(settings, centre_m);
+  BruteForceIntegrator reference(settings, centre_m);
+  uint64_t hash = 0xcbf29ce484222325ull;
+  for (const RayBatch& scan : scans) {
+    const IntegrationStats a = cpu->integrate(scan);
+    const IntegrationStats b = reference.integrate(scan);
+    EXPECT_EQ(a.rays, b.rays);
+    EXPECT_EQ(a.voxels_updated, b.voxels_updated);
+    const std::vector<uint32_t> map = cpu->download();
+    size_t differing = 0;
+    for (size_t i = 0; i < map.size(); ++i) differing += map[i] != reference.map()[i] ? 1 : 0;
+    EXPECT_EQ(differing, 0u) << "of " << map.size() << " voxels";
+    hash = fnv1a(hash, a.rays);
+    hash = fnv1a(hash, a.voxels_updated);
+    for (const uint32_t v : map) hash = fnv1a(hash, v);
+  }
+  std::printf("[ hash     ] 0x%016llx\n", static_cast<unsigned long long>(hash));
+  return hash;
+}
+
+float os1_interpolation_slope() {
+  const config::SensorModel os1 = config::sensor_preset("os1-128");
+  return static_cast<float>(std::tan(os1.vertical_fov_rad() / os1.beams));
+}
+
+TEST(CpuIntegratorExact, IndoorDefaultMapInterpolationReduction) {
+  TsdfSettings s;  // the default 40 x 40 x 15 m map at 6.4 cm, as the pipeline uses it
+  s.interpolation_slope = os1_interpolation_slope();
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(3, false)),
+            0xba8163921710b792ull);
+}
+
+TEST(CpuIntegratorExact, OutdoorRaysLeaveTheMap) {
+  TsdfSettings s;
+  s.map_size_m = {20.0f, 16.0f, 8.0f};
+  s.interpolation_slope = os1_interpolation_slope();
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(3, true)),
+            0xa87b17339ba69ddeull);
+}
+
+TEST(CpuIntegratorExact, EveryRayNoInterpolation) {
+  TsdfSettings s;
+  s.map_size_m = {24.0f, 24.0f, 8.0f};
+  s.reduce_points_per_voxel = false;
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(2, false)),
+            0x16a901aaf4f50573ull);
+}
+
+TEST(CpuIntegratorExact, EveryRayWithInterpolation) {
+  TsdfSettings s = test::small_map_settings();
+  s.reduce_points_per_voxel = false;
+  s.interpolation_slope = os1_interpolation_slope();
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(2, false)),
+            0x632eb59c678b29bdull);
+}
+
+TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
+  // A 8 x 8 x 4 m map ahead of the sensor: rays enter it from outside, some only pass it.
+  TsdfSettings s;
+  s.map_size_m = {8.0f, 8.0f, 4.0f};
+  s.interpolation_slope = os1_interpolation_slope();
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), box_room_rays(2, false)),
+            0x4761511e2fed3bc0ull);
+}
+
+TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
+  // The CPU integrator shares the map out among sectors by its thread count: one thread
+  // (four sectors) and seven (28 sectors, more candidates handed between them) must give the
+  // same map as the brute-force integrator.
+  TsdfSettings s;
+  s.map_size_m = {16.0f, 16.0f, 6.0f};
+  s.interpolation_slope = os1_interpolation_slope();
+  const std::vector<RayBatch> scans = box_room_rays(2, false);
+  for (const int threads : {1, 7}) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans),
+                0xb30418ff7c191ab9ull)
+          << threads << " threads";
+    });
+  }
+}
+
+TEST(CpuIntegratorExact, RepeatedScansReachTheWeightCapWithOneOrigin) {
+  // One origin for the whole scan, the same scan again and again: weights reach the cap, and
+  // values behind the surface get partial weights. Bad points are in the batch too.
+  TsdfSettings s = test::small_map_settings();
+  s.max_weight = 4.0f;
+  s.interpolation_slope = os1_interpolation_slope();
+  const double origin[3] = {0.3, -0.2, 1.1};
+  const double centre[3] = {3.0, 1.0, 1.5};
+  RayBatch scan =
+      test::cast_rays(config::sensor_preset("os1-128"), origin, test::sphere(centre, 1.5));
+  const double normal[3] = {-0.9, 0.1, 0.1};
+  const RayBatch wall =
+      test::cast_rays(config::sensor_preset("os1-128"), origin, test::plane(normal, -4.0));
+  scan.endpoints_m.insert(scan.endpoints_m.end(), wall.endpoints_m.begin(), wall.endpoints_m.end());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  scan.endpoints_m.push_back({nan, 1.0f, 1.0f});
+  scan.endpoints_m.push_back({std::numeric_limits<float>::infinity(), 0.0f, 0.0f});
+  scan.endpoints_m.push_back({1e20f, -1e20f, 3e38f});
+  scan.endpoints_m.push_back(scan.origins_m.front());
+  scan.up = test::make_vec(0.1 / std::sqrt(1.01), 0.0, 1.0 / std::sqrt(1.01));  // a tilted sensor
+  const std::vector<RayBatch> scans(6, scan);
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(0, 0, 1), scans), 0x6708b25316a676c5ull);
+}
+
+}  // namespace
+}  // namespace featsense::tsdf

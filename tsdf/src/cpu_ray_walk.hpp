@@ -1,0 +1,171 @@
+#pragma once
+// The CPU's walk of one ray: exactly the candidates of detail::march_ray (ray_marcher.hpp,
+// which the CUDA kernel compiles), computed with less work per voxel. The float operations
+// that decide which voxels are visited and what they get are the same ones in the same order,
+// so the results are bit for bit the same (test_cpu_integrator_exact checks it against
+// march_ray itself); only bookkeeping is cheaper:
+// - the storage index and the map-bounds test follow the traversal incrementally instead of
+//   being recomputed from the global index at every voxel;
+// - of the projective distance, only the term of the axis just stepped is recomputed (each
+//   term is the same product as in march_ray, and the sum is formed in the same order);
+// - free space (d >= tau) needs no division: d / tau >= 1 there, so the clamped value is
+//   exactly kValueScale, and there is no interpolation.
+
+#include <type_traits>
+
+#include "ray_marcher.hpp"
+
+namespace featsense::tsdf::detail {
+
+/// Calls visit(linear_index, value_fixed, interpolated) for every candidate march_ray would
+/// propose for this ray, in the same order.
+template <typename Visit>
+inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
+                     const RayMarchParams& params, Visit&& visit) {
+  const Vec3 delta = endpoint - origin;
+  const float range = norm(delta);
+  if (!(range > 0.0f && range < 1.0e30f)) return;
+  const Vec3 dir = (1.0f / range) * delta;
+  float t0 = 0.0f;
+  float t1 = range + params.truncation_m;
+  if (!clip_to_box(origin, dir, map.min_corner(), map.max_corner(), t0, t1)) return;
+
+  Vec3 across = cross(dir, cross(dir, params.up));
+  const float across_length = norm(across);
+  const bool interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
+  if (interpolate) across = (1.0f / across_length) * across;
+
+  const float vs = map.voxel_size_m;
+  const Vec3 walk_start = origin + t1 * dir;
+  const Vec3 walk_dir = -1.0f * dir;
+  const float walk_length = t1 - t0;
+  const Index3 start = map.voxel_of(walk_start);
+  const Index3 start_brick = map.wrapped_brick(start);
+  const Index3 start_local = LocalMapGeometry::local_in_brick(start);
+  const Index3 nb = map.bricks();
+
+  int32_t step[3] = {};
+  float t_next[3] = {};
+  float t_delta[3] = {};
+  int32_t voxel[3] = {};   // global index
+  int32_t offset[3] = {};  // index relative to the map's lowest corner: inside when in [0, dim)
+  int32_t dim[3] = {};     // voxels per axis
+  int32_t brick[3] = {};   // ring-buffer slot coordinates of the current brick
+  int32_t local[3] = {};   // place in the brick
+  int32_t bricks[3] = {};  // bricks per axis
+  float term[3] = {};      // (centre - origin)[axis] * dir[axis], as dot() forms it
+  float origin_c[3] = {};
+  float dir_c[3] = {};
+  for (int axis = 0; axis < 3; ++axis) {
+    const float d = component(walk_dir, axis);
+    const float o = component(walk_start, axis);
+    const int32_t v = component(start, axis);
+    if (d > 0.0f) {
+      step[axis] = 1;
+      t_next[axis] = ((static_cast<float>(v) + 1.0f) * vs - o) / d;
+      t_delta[axis] = vs / d;
+    } else if (d < 0.0f) {
+      step[axis] = -1;
+      t_next[axis] = (static_cast<float>(v) * vs - o) / d;
+      t_delta[axis] = -vs / d;
+    } else {
+      step[axis] = 0;
+      t_next[axis] = FLT_MAX;
+      t_delta[axis] = FLT_MAX;
+    }
+    voxel[axis] = v;
+    offset[axis] = v - component(map.origin, axis);
+    dim[axis] = component(map.dim, axis);
+    brick[axis] = component(start_brick, axis);
+    local[axis] = component(start_local, axis);
+    bricks[axis] = component(nb, axis);
+    origin_c[axis] = component(origin, axis);
+    dir_c[axis] = component(dir, axis);
+    // centre_of(voxel)[axis] - origin[axis], times dir[axis]: the terms of dot() in march_ray.
+    term[axis] = ((static_cast<float>(v) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
+  }
+  const auto linear = [&] {
+    return map.linear_from({brick[0], brick[1], brick[2]}, {local[0], local[1], local[2]});
+  };
+  // Storage strides of one step inside a brick, per axis.
+  const int64_t local_stride[3] = {1, kBrickSize, kBrickSize * kBrickSize};
+  int64_t index = static_cast<int64_t>(linear());
+
+  // map.linear for a voxel known to lie in the map, without its three divisions: the brick's
+  // offset from the map's lowest brick is below the brick count, so wrapping it is one
+  // comparison (the map's lowest corner is a whole brick, so the place in the brick is too).
+  const Index3 lowest_slot = map.wrapped_brick(map.origin);
+  const auto linear_of_contained = [&](Index3 g) {
+    const auto slot = [](int32_t relative, int32_t lowest, int32_t count) {
+      const int32_t b = lowest + (relative >> kBrickShift);
+      return b >= count ? b - count : b;
+    };
+    const Index3 r{g.x - map.origin.x, g.y - map.origin.y, g.z - map.origin.z};
+    return map.linear_from({slot(r.x, lowest_slot.x, nb.x), slot(r.y, lowest_slot.y, nb.y),
+                            slot(r.z, lowest_slot.z, nb.z)},
+                           LocalMapGeometry::local_in_brick(r));
+  };
+
+  const float tau = params.truncation_m;
+  float t = 0.0f;
+  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
+  for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
+    const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
+                        static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
+                        static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
+    if (inside) {
+      const float along = (term[0] + term[1]) + term[2];
+      const float distance = range - along;
+      if (distance >= tau) {
+        visit(static_cast<size_t>(index), kValueScale, false);
+      } else if (distance >= -tau) {
+        const int32_t value = distance_to_fixed(distance, tau);
+        visit(static_cast<size_t>(index), value, false);
+        if (interpolate) {
+          const Index3 g{voxel[0], voxel[1], voxel[2]};
+          const Vec3 centre = map.centre_of(g);
+          const float half_height = params.interpolation_slope * along;
+          const int32_t reach = static_cast<int32_t>(half_height / vs);
+          for (int32_t k = 1; k <= reach; ++k) {
+            const float shift = static_cast<float>(k) * vs;
+            const Index3 above = map.voxel_of(centre + shift * across);
+            const Index3 below = map.voxel_of(centre - shift * across);
+            if (map.contains(above)) visit(linear_of_contained(above), value, true);
+            if (map.contains(below)) visit(linear_of_contained(below), value, true);
+          }
+        }
+      }
+    }
+    // Step into the neighbour across the nearest voxel face (march_ray's rule). Each axis has
+    // its own code, so that every array above is indexed by a constant and lives in registers.
+    const auto step_along = [&](auto axis_constant) {
+      constexpr int axis = decltype(axis_constant)::value;
+      t = t_next[axis];
+      t_next[axis] += t_delta[axis];
+      const int32_t s = step[axis];
+      voxel[axis] += s;
+      offset[axis] += s;
+      term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
+      local[axis] += s;
+      if (local[axis] == kBrickSize || local[axis] < 0) {
+        local[axis] -= s * kBrickSize;
+        brick[axis] += s;
+        if (brick[axis] == bricks[axis]) brick[axis] = 0;
+        if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+        index = static_cast<int64_t>(linear());
+      } else {
+        index += s * local_stride[axis];
+      }
+    };
+    const bool y_first = t_next[1] < t_next[0];
+    if (t_next[2] < (y_first ? t_next[1] : t_next[0])) {
+      step_along(std::integral_constant<int, 2>());
+    } else if (y_first) {
+      step_along(std::integral_constant<int, 1>());
+    } else {
+      step_along(std::integral_constant<int, 0>());
+    }
+  }
+}
+
+}  // namespace featsense::tsdf::detail
