@@ -5,9 +5,12 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
 cmake -S . -B build-gpu -G Ninja -DCMAKE_CUDA_ARCHITECTURES=90 -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
-ninja -C build-gpu featsense tsdf_test_cuda_integrator tsdf_test_cpu_integrator
+tests=(tsdf_test_cuda_integrator tsdf_test_cpu_integrator tsdf_test_cpu_integrator_exact
+       storage_test_shifting_map)
+ninja -C build-gpu featsense "${tests[@]}"
 data=../shared/data/ouster
 extras=()
-[ -d "$data" ] && extras=(-- "$data/OS-1-128_v2.3.0_1024x10_lb_n3.pcap" "$data/OS-1-128_v2.3.0_1024x10.json")
+[ -d "$data" ] && extras=(-- "$data/OS-1-128_v2.3.0_1024x10_lb_n3.pcap" "$data/OS-1-128_v2.3.0_1024x10.json"
+                          "$data/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt")
 ../shared/tools/device-bundle .device/bundle.tar.xz build-gpu/app/featsense \
-  build-gpu/test/tsdf_test_cuda_integrator build-gpu/test/tsdf_test_cpu_integrator "${extras[@]}"
+  "${tests[@]/#/build-gpu/test/}" "${extras[@]}"
