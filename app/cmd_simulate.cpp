@@ -109,8 +109,12 @@ PreparedSimulation::PreparedSimulation(const SimulateOptions& o) {
                                 " s: room for " + std::to_string(available) + " frames, not " +
                                 std::to_string(o.frames));
   frames = o.frames > 0 ? static_cast<uint64_t>(o.frames) : available;
+  // A little room around the scene: a drone above a roofless house or a walker at the edge
+  // of a ground quad is fine; a path in the wrong units or frame is far off and still caught.
+  constexpr double kMarginM = 2.0;
   slam::check_trajectory_inside(*trajectory, mesh,
-                                static_cast<double>(frames) / settings.sensor.rate_hz);
+                                static_cast<double>(frames) / settings.sensor.rate_hz, 0.01,
+                                kMarginM);
 }
 
 slam::Trajectory PreparedSimulation::frame_poses() const {

@@ -14,3 +14,12 @@ extras=()
                           "$data/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt")
 ../shared/tools/device-bundle .device/bundle.tar.xz build-gpu/app/featsense \
   "${tests[@]/#/build-gpu/test/}" "${extras[@]}"
+# Without debug information the bundle is half the size (the carry limit is 64 MiB).
+work=$(mktemp -d)
+tar xJf .device/bundle.tar.xz -C "$work"
+strip --strip-debug "$work"/bundle/bin/* "$work"/bundle/lib/libfeatsense_*
+tar cf - -C "$work" bundle | xz -T2 -6 > .device/bundle.tar.xz
+rm -rf "$work"
+# The two real places for the scene runs of run_gpu_checks.sh.
+mkdir -p .device/scenes
+cp ../shared/data/scenes/small_house.ply ../shared/data/scenes/gas_station_with_ground.ply .device/scenes/ 2>/dev/null || true

@@ -59,6 +59,20 @@ if [ "$what" = map ] || [ "$what" = all ]; then
   "$bin/featsense" map /tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3.pcap --meta /tmp/bundle/OS-1-128_v2.3.0_1024x10.json \
     --gt /tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt -o "$out/map_os1" --backend cuda --quiet
   report "$out/map_os1/report.json" "map os1 real"
+  # The two real places (meshes in .device/scenes/), on the paths of make_scene_paths.py.
+  python3 test/bench/make_scene_paths.py /tmp/paths
+  for scene in small_house gas_station; do
+    mesh=.device/scenes/$scene.ply
+    [ "$scene" = gas_station ] && mesh=.device/scenes/gas_station_with_ground.ply
+    [ -f "$mesh" ] || continue
+    "$bin/featsense" simulate --quiet --scene "$mesh" --trajectory /tmp/paths/$scene.tum -o /tmp/$scene
+    "$bin/featsense" map /tmp/$scene -o "$out/map_$scene" --gt /tmp/$scene/gt_trajectory.tum --backend cuda --quiet
+    report "$out/map_$scene/report.json" "map $scene"
+  done
+  # Peak memory of a short and a long run of the same drive: it must not grow with the run.
+  "$bin/featsense" map "$sim" -o /tmp/rss_short --gt "$sim/gt_trajectory.tum" --backend cuda --quiet --end 40 --no-mesh
+  report /tmp/rss_short/report.json "map parking first 40 frames"
+  du -b "$out/map_parking_cuda/map.h5" | awk '{print "parking map.h5 bytes", $1}'
   rm -f "$out"/map_*/map.h5 "$out"/map_*/map.h5.journal "$out"/map_*/mesh.*
   /usr/bin/time -v "$bin/featsense" demo -o /tmp/demo --backend cuda 2>&1 | grep -E "demo|mapped|mesh|against|Maximum resident|Elapsed"
   cp /tmp/demo/report.json "$out/demo_report.json"
