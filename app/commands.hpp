@@ -22,8 +22,8 @@ Command register_info(CLI::App& app, const CliContext& context);
 Command register_convert(CLI::App& app, const CliContext& context);
 /// `featsense simulate --scene NAME|MESH -o DIR`: a simulated recording with ground truth.
 Command register_simulate(CLI::App& app, const CliContext& context);
-/// `featsense bench tsdf ...`: speed figures as JSON.
-Command register_bench(CLI::App& app, const CliContext& context);
+/// `featsense bench tsdf|mesh ...`: speed figures as JSON (one command per benchmark).
+std::vector<Command> register_bench(CLI::App& app, const CliContext& context);
 /// `featsense eval traj|mesh ...`: figures against ground truth (one command per subcommand).
 std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
 /// `featsense export MESH -o FILE`: a mesh in another format, chosen by the extension.

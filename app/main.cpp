@@ -46,11 +46,11 @@ int main(int argc, char** argv) {
   std::vector<featsense::app::Command> commands = {featsense::app::register_info(app, context),
                                                    featsense::app::register_convert(app, context),
                                                    featsense::app::register_simulate(app, context),
-                                                   featsense::app::register_bench(app, context),
                                                    featsense::app::register_export(app, context),
                                                    featsense::app::register_navmesh(app, context),
                                                    featsense::app::register_mesh(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
+  for (auto& command : featsense::app::register_bench(app, context)) commands.push_back(command);
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.
   for (const auto& command : commands) {

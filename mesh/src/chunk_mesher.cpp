@@ -36,8 +36,7 @@ class CubeMarcher {
               std::vector<int32_t>& slots, ChunkMesh& out)
       : voxels_(block.voxels), key_(block.key), parameters_(parameters), slots_(slots), out_(out) {
     for (int c = 0; c < 8; ++c) {
-      corner_offset_[static_cast<size_t>(c)] =
-          (c & 1) * kStride[0] + ((c >> 1) & 1) * kStride[1] + ((c >> 2) & 1) * kStride[2];
+      code_offset_[static_cast<size_t>(c)] = code_index(c & 1, (c >> 1) & 1, (c >> 2) & 1);
     }
   }
 
@@ -57,49 +56,53 @@ class CubeMarcher {
           const tsdf::Index3 hi{std::min(bx + kBlockCubes, end.x),
                                 std::min(by + kBlockCubes, end.y),
                                 std::min(bz + kBlockCubes, end.z)};
-          if (has_sign_change(lo, hi)) march_block(lo, hi);
+          if (code_corners(lo, hi)) march_block(lo, hi);
         }
   }
 
  private:
-  /// Whether observed corners of the cubes [lo, hi) have both signs; most blocks have not.
-  bool has_sign_change(tsdf::Index3 lo, tsdf::Index3 hi) const {
-    bool negative = false;
-    bool positive = false;
-    const uint32_t min_weight = parameters_.min_weight_fixed;
+  /// Codes the corners of the cubes [lo, hi) (bit 0 negative, bit 1 observed) and says
+  /// whether observed corners have both signs; most blocks have not. Branch-free, so that the
+  /// compiler vectorises the rows: an observed voxel has bits >= min_weight << 16.
+  bool code_corners(tsdf::Index3 lo, tsdf::Index3 hi) {
+    const uint32_t observed_from = parameters_.min_weight_fixed << 16;
+    uint32_t negative = 0;
+    uint32_t positive = 0;
+    const int32_t nx = hi.x - lo.x + 1;
     for (int32_t z = lo.z; z <= hi.z; ++z)
       for (int32_t y = lo.y; y <= hi.y; ++y) {
-        const uint32_t* row = voxels_.data() + PaddedBlock::index(0, y, z);
-        for (int32_t x = lo.x; x <= hi.x; ++x) {
+        const uint32_t* row = voxels_.data() + PaddedBlock::index(lo.x, y, z);
+        uint8_t* codes = codes_.data() + code_index(0, y - lo.y, z - lo.z);
+        for (int32_t x = 0; x < nx; ++x) {
           const uint32_t bits = row[x];
-          if (weight_of(bits) < min_weight) continue;
-          if (value_of(bits) < 0) {
-            negative = true;
-          } else {
-            positive = true;
-          }
+          const uint32_t observed = bits >= observed_from ? 1u : 0u;
+          const uint32_t sign = (bits >> 15) & 1u;
+          negative |= observed & sign;
+          positive |= observed & (sign ^ 1u);
+          codes[x] = static_cast<uint8_t>(sign | (observed << 1));
         }
-        if (negative && positive) return true;
       }
-    return false;
+    return (negative & positive) != 0u;
+  }
+
+  static std::size_t code_index(int32_t x, int32_t y, int32_t z) {
+    return static_cast<std::size_t>(x + (kBlockCubes + 1) * (y + (kBlockCubes + 1) * z));
   }
 
   void march_block(tsdf::Index3 lo, tsdf::Index3 hi) {
     const auto& cases = cube_cases();
-    const uint32_t min_weight = parameters_.min_weight_fixed;
     for (int32_t z = lo.z; z < hi.z; ++z)
       for (int32_t y = lo.y; y < hi.y; ++y)
         for (int32_t x = lo.x; x < hi.x; ++x) {
-          const std::size_t base = PaddedBlock::index(x, y, z);
+          const uint8_t* base = codes_.data() + code_index(x - lo.x, y - lo.y, z - lo.z);
+          uint32_t all = 0xFFu;
           int case_bits = 0;
-          bool observed = true;
           for (int c = 0; c < 8; ++c) {
-            const uint32_t bits =
-                voxels_[base + static_cast<size_t>(corner_offset_[static_cast<size_t>(c)])];
-            observed = observed && weight_of(bits) >= min_weight;
-            case_bits |= (value_of(bits) < 0 ? 1 : 0) << c;
+            const uint8_t code = base[code_offset_[static_cast<size_t>(c)]];
+            all &= code;
+            case_bits |= (code & 1) << c;
           }
-          if (!observed || case_bits == 0 || case_bits == 255) continue;
+          if ((all & 2u) == 0u || case_bits == 0 || case_bits == 255) continue;
           const CubeCase& cube_case = cases[static_cast<size_t>(case_bits)];
           for (int t = 0; t < cube_case.triangle_count; ++t) {
             const auto& edges = cube_case.triangles[static_cast<size_t>(t)];
@@ -186,7 +189,9 @@ class CubeMarcher {
   const ChunkMeshingParameters& parameters_;
   std::vector<int32_t>& slots_;
   ChunkMesh& out_;
-  std::array<int32_t, 8> corner_offset_{};
+  std::array<std::size_t, 8> code_offset_{};
+  /// Corner codes of the block being marched.
+  std::array<uint8_t, (kBlockCubes + 1) * (kBlockCubes + 1) * (kBlockCubes + 1)> codes_{};
   std::vector<std::size_t> touched_;
 };
 
