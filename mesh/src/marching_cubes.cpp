@@ -74,8 +74,10 @@ struct WorkItem {
   internal::ChunkMeshingParameters parameters;
 };
 
-/// Assembles the padded chunk (in a buffer kept per thread) and meshes it.
+/// Assembles the padded chunk (in a buffer kept per thread) and meshes it, unless a cheap
+/// look at the signs shows that nothing is to be found.
 internal::ChunkMesh mesh_item(const WorkItem& item) {
+  if (!internal::may_have_faces(item.neighbourhood, item.parameters.min_weight_fixed)) return {};
   thread_local internal::PaddedBlock block;
   internal::fill_padded_block(item.neighbourhood, block);
   return internal::mesh_chunk(block, item.parameters);

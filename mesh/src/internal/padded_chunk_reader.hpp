@@ -49,6 +49,11 @@ class PaddedChunkReader {
   std::size_t reads_ = 0;
 };
 
+/// False when no cube of the chunk can get a face: the observed voxels its cubes reach (its
+/// own and the lower faces of its +x/+y/+z neighbours) are all on one side of the surface.
+/// Much cheaper than padding and marching a chunk of free space.
+bool may_have_faces(const ChunkNeighbourhood& neighbourhood, uint32_t min_weight_fixed);
+
 /// The chunk with one voxel before and two after it; unobserved where no chunk is stored.
 void fill_padded_block(const ChunkNeighbourhood& neighbourhood, PaddedBlock& block);
 
