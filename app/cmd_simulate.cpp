@@ -112,9 +112,8 @@ PreparedSimulation::PreparedSimulation(const SimulateOptions& o) {
   // A little room around the scene: a drone above a roofless house or a walker at the edge
   // of a ground quad is fine; a path in the wrong units or frame is far off and still caught.
   constexpr double kMarginM = 2.0;
-  slam::check_trajectory_inside(*trajectory, mesh,
-                                static_cast<double>(frames) / settings.sensor.rate_hz, 0.01,
-                                kMarginM);
+  slam::check_trajectory_inside(
+      *trajectory, mesh, static_cast<double>(frames) / settings.sensor.rate_hz, 0.01, kMarginM);
 }
 
 slam::Trajectory PreparedSimulation::frame_poses() const {

@@ -28,8 +28,8 @@ Command register_demo(CLI::App& app, const CliContext& context);
 Command register_bench_store(CLI::App& bench, const CliContext& context);
 /// `featsense map INPUT -o OUT --gt TRAJ ...`: the mapping pipeline.
 Command register_map(CLI::App& app, const CliContext& context);
-/// `featsense bench tsdf ...`: speed figures as JSON.
-Command register_bench(CLI::App& app, const CliContext& context);
+/// `featsense bench tsdf|mesh ...`: speed figures as JSON (one command per benchmark).
+std::vector<Command> register_bench(CLI::App& app, const CliContext& context);
 /// `featsense eval traj|mesh ...`: figures against ground truth (one command per subcommand).
 std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
 /// `featsense export MESH -o FILE`: a mesh in another format, chosen by the extension.

@@ -49,11 +49,11 @@ int main(int argc, char** argv) {
                                                    featsense::app::register_simulate(app, context),
                                                    featsense::app::register_map(app, context),
                                                    featsense::app::register_demo(app, context),
-                                                   featsense::app::register_bench(app, context),
                                                    featsense::app::register_export(app, context),
                                                    featsense::app::register_navmesh(app, context),
                                                    featsense::app::register_mesh(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
+  for (auto& command : featsense::app::register_bench(app, context)) commands.push_back(command);
   commands.push_back(featsense::app::register_bench_store(*app.get_subcommand("bench"), context));
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.

@@ -19,7 +19,8 @@ struct MapMesh {
   double write_s = 0.0;
 };
 
-/// Meshes the map at `map_path` and writes `out`/mesh.ply and `out`/mesh.glb.
+/// Meshes the map at `map_path` and writes `out`/mesh.ply, mesh.glb and topdown.png (a
+/// height-coloured view from above).
 MapMesh mesh_map(const std::filesystem::path& map_path, const std::filesystem::path& out);
 nlohmann::json mesh_json(const MapMesh& result);
 

@@ -70,9 +70,18 @@ void check_settings(const MeshingSettings& settings, const storage::MapMetadata&
 }
 
 struct WorkItem {
-  std::unique_ptr<internal::PaddedBlock> block;  ///< null: nothing to mesh
+  internal::ChunkNeighbourhood neighbourhood;
   internal::ChunkMeshingParameters parameters;
 };
+
+/// Assembles the padded chunk (in a buffer kept per thread) and meshes it, unless a cheap
+/// look at the signs shows that nothing is to be found.
+internal::ChunkMesh mesh_item(const WorkItem& item) {
+  if (!internal::may_have_faces(item.neighbourhood, item.parameters.min_weight_fixed)) return {};
+  thread_local internal::PaddedBlock block;
+  internal::fill_padded_block(item.neighbourhood, block);
+  return internal::mesh_chunk(block, item.parameters);
+}
 
 }  // namespace
 
@@ -97,13 +106,13 @@ TriangleMesh extract_mesh(storage::ChunkStore& store, const MeshingSettings& set
     if (local_cube_range(key, bounds, parameters)) work.emplace_back(key, parameters);
   }
 
-  internal::PaddedChunkReader reader(store, base.min_weight_fixed, stored);
+  internal::PaddedChunkReader reader(store, stored);
   internal::MeshWelder welder(true);
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    // Chunks are read in order by one thread (the store is not thread-safe), meshed in
-    // parallel and welded in the same order, so the mesh does not depend on the threads;
-    // the tokens bound the padded chunks in flight.
+    // Chunks are read in order by one thread (the store is not thread-safe), padded and
+    // meshed in parallel and welded in the same order, so the mesh does not depend on the
+    // threads; the tokens bound the chunks in flight.
     const auto tokens = static_cast<size_t>(2 * arena.max_concurrency() + 2);
     size_t next = 0;
     tbb::parallel_pipeline(
@@ -116,25 +125,19 @@ TriangleMesh extract_mesh(storage::ChunkStore& store, const MeshingSettings& set
                 return nullptr;
               }
               auto item = std::make_shared<WorkItem>();
-              item->block = reader.read(work[next].first);
+              item->neighbourhood = reader.read(work[next].first);
               item->parameters = work[next].second;
               ++next;
               return item;
             }) &
             tbb::make_filter<std::shared_ptr<WorkItem>, std::shared_ptr<internal::ChunkMesh>>(
                 tbb::filter_mode::parallel,
-                [](const std::shared_ptr<WorkItem>& item) -> std::shared_ptr<internal::ChunkMesh> {
-                  if (!item->block) return nullptr;
-                  auto part = std::make_shared<internal::ChunkMesh>(
-                      internal::mesh_chunk(*item->block, item->parameters));
-                  item->block.reset();  // the padded chunk is not needed while welding waits
-                  return part;
+                [](const std::shared_ptr<WorkItem>& item) {
+                  return std::make_shared<internal::ChunkMesh>(mesh_item(*item));
                 }) &
             tbb::make_filter<std::shared_ptr<internal::ChunkMesh>, void>(
                 tbb::filter_mode::serial_in_order,
-                [&](const std::shared_ptr<internal::ChunkMesh>& part) {
-                  if (part) welder.add(*part);
-                }));
+                [&](const std::shared_ptr<internal::ChunkMesh>& part) { welder.add(*part); }));
   });
   TriangleMesh mesh = welder.take();
   if (stats != nullptr) {

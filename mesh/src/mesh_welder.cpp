@@ -17,7 +17,6 @@ void MeshWelder::add(const ChunkMesh& part) {
   for (const auto& [local, edge] : part.seam_vertices) {
     seam_.emplace(edge, remap_[static_cast<size_t>(local)]);
   }
-  mesh_.triangles.reserve(mesh_.triangles.size() + part.triangles.size());
   for (const Eigen::Vector3i& t : part.triangles) {
     mesh_.triangles.emplace_back(remap_[static_cast<size_t>(t[0])],
                                  remap_[static_cast<size_t>(t[1])],

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <utility>
 
 namespace featsense::mesh::internal {
@@ -10,9 +11,6 @@ namespace {
 
 using storage::ChunkKey;
 using storage::kChunkSize;
-
-constexpr uint8_t kNegative = 1;
-constexpr uint8_t kPositive = 2;
 
 /// The most chunks of one (x, y) column: the neighbours of one chunk span 3 x 3 columns, and
 /// those of the next chunks in sorted order mostly the same ones.
@@ -23,12 +21,81 @@ std::size_t longest_column(const std::vector<ChunkKey>& keys) {
   return longest;
 }
 
+/// Copies the part of a neighbour (offset dx, dy, dz in chunks) that lies in the padded block,
+/// or zeros (unobserved) where there is none: per axis its last voxel (offset -1), all of it
+/// (0) or its first two voxels (+1).
+void copy_neighbour(const storage::Chunk* chunk, int dx, int dy, int dz, PaddedBlock& block) {
+  auto range = [](int offset, int32_t& from, int32_t& to) {
+    from = offset < 0 ? kChunkSize - 1 : 0;
+    to = offset > 0 ? 2 : kChunkSize;
+  };
+  int32_t x0 = 0, x1 = 0, y0 = 0, y1 = 0, z0 = 0, z1 = 0;
+  range(dx, x0, x1);
+  range(dy, y0, y1);
+  range(dz, z0, z1);
+  const auto count = static_cast<std::size_t>(x1 - x0);
+  for (int32_t z = z0; z < z1; ++z)
+    for (int32_t y = y0; y < y1; ++y) {
+      uint32_t* target =
+          block.voxels.data() +
+          PaddedBlock::index(x0 + dx * kChunkSize, y + dy * kChunkSize, z + dz * kChunkSize);
+      if (chunk == nullptr) {
+        std::fill(target, target + count, 0u);
+      } else {
+        const uint32_t* source = chunk->voxels.data() + storage::Chunk::index(x0, y, z);
+        std::copy(source, source + count, target);
+      }
+    }
+}
+
+/// Sign bits of the observed voxels among `count` voxels `stride` apart: bit 0 negative,
+/// bit 1 not negative. Branch-free so that the compiler vectorises the contiguous case.
+uint32_t observed_signs(const uint32_t* voxels, std::size_t count, std::size_t stride,
+                        uint32_t observed_from) {
+  uint32_t negative = 0;
+  uint32_t positive = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const uint32_t bits = voxels[i * stride];
+    const uint32_t observed = bits >= observed_from ? 1u : 0u;
+    const uint32_t sign = (bits >> 15) & 1u;
+    negative |= observed & sign;
+    positive |= observed & (sign ^ 1u);
+  }
+  return negative | (positive << 1);
+}
+
 }  // namespace
 
-PaddedChunkReader::PaddedChunkReader(storage::ChunkStore& store, uint32_t min_weight_fixed,
-                                     const std::vector<ChunkKey>& keys)
+bool may_have_faces(const ChunkNeighbourhood& neighbourhood, uint32_t min_weight_fixed) {
+  const uint32_t observed_from = min_weight_fixed << 16;
+  const auto& own = neighbourhood.chunks[13];
+  if (!own) return false;
+  constexpr std::size_t kPlane = static_cast<std::size_t>(kChunkSize) * kChunkSize;
+  uint32_t signs = 0;
+  // Plane by plane, so that a chunk with a surface is found out early.
+  for (int32_t z = 0; z < kChunkSize && signs != 3u; ++z)
+    signs |= observed_signs(own->voxels.data() + z * kPlane, kPlane, 1, observed_from);
+  if (signs == 3u) return true;
+  for (int dz = 0; dz <= 1; ++dz)
+    for (int dy = 0; dy <= 1; ++dy)
+      for (int dx = 0; dx <= 1; ++dx) {
+        const auto& chunk =
+            neighbourhood.chunks[static_cast<std::size_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1))];
+        if (dx + dy + dz == 0 || !chunk) continue;
+        const uint32_t* v = chunk->voxels.data();
+        // The z = 0 plane is contiguous; the y = 0 plane is 64 rows a plane apart; the x = 0
+        // plane is every 64th voxel.
+        signs |= observed_signs(v, kPlane, 1, observed_from);
+        for (int32_t z = 0; z < kChunkSize; ++z)
+          signs |= observed_signs(v + storage::Chunk::index(0, 0, z), kChunkSize, 1, observed_from);
+        signs |= observed_signs(v, kPlane, kChunkSize, observed_from);
+        if (signs == 3u) return true;
+      }
+  return signs == 3u;
+}
+
+PaddedChunkReader::PaddedChunkReader(storage::ChunkStore& store, const std::vector<ChunkKey>& keys)
     : store_(store),
-      min_weight_fixed_(min_weight_fixed),
       present_(keys.begin(), keys.end()),
       capacity_(12 * longest_column(keys) + 27) {}
 
@@ -46,7 +113,6 @@ std::shared_ptr<const storage::Chunk> PaddedChunkReader::chunk(const ChunkKey& k
     return nullptr;
   }
   auto shared = std::make_shared<const storage::Chunk>(std::move(*read));
-  if (signs_.count(key) == 0) signs_[key] = measure_signs(*shared);
   lru_.push_front(key);
   cache_[key] = Cached{shared, lru_.begin()};
   while (cache_.size() > capacity_) {
@@ -56,75 +122,29 @@ std::shared_ptr<const storage::Chunk> PaddedChunkReader::chunk(const ChunkKey& k
   return shared;
 }
 
-PaddedChunkReader::Signs PaddedChunkReader::signs(const ChunkKey& key) {
-  auto found = signs_.find(key);
-  if (found != signs_.end()) return found->second;
-  if (!chunk(key)) return {};
-  return signs_[key];
-}
-
-PaddedChunkReader::Signs PaddedChunkReader::measure_signs(const storage::Chunk& chunk) const {
-  Signs signs;
-  for (int32_t z = 0; z < kChunkSize; ++z)
-    for (int32_t y = 0; y < kChunkSize; ++y) {
-      const uint32_t* row = chunk.voxels.data() + storage::Chunk::index(0, y, z);
-      uint8_t row_signs = 0;
-      for (int32_t x = 0; x < kChunkSize; ++x) {
-        const uint32_t bits = row[x];
-        if ((bits >> 16) < min_weight_fixed_) continue;
-        const uint8_t sign = (bits & 0x8000u) != 0u ? kNegative : kPositive;  // int16 sign bit
-        row_signs |= sign;
-        if (x == 0 || y == 0 || z == 0) signs.lower_faces |= sign;
-      }
-      signs.all |= row_signs;
-    }
-  return signs;
-}
-
-std::unique_ptr<PaddedBlock> PaddedChunkReader::read(const ChunkKey& key) {
-  // The cubes of this chunk reach its own voxels and the lower faces of its +x/+y/+z
-  // neighbours; without both signs there, no cube changes sign.
-  uint8_t reached = signs(key).all;
-  for (int dz = 0; dz <= 1; ++dz)
-    for (int dy = 0; dy <= 1; ++dy)
-      for (int dx = 0; dx <= 1; ++dx) {
-        if (dx + dy + dz == 0) continue;
-        reached |= signs({key.x + dx, key.y + dy, key.z + dz}).lower_faces;
-      }
-  if (reached != (kNegative | kPositive)) return nullptr;
-
-  auto block = std::make_unique<PaddedBlock>();
-  block->key = key;
+ChunkNeighbourhood PaddedChunkReader::read(const ChunkKey& key) {
+  ChunkNeighbourhood out;
+  out.key = key;
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const auto neighbour = chunk({key.x + dx, key.y + dy, key.z + dz});
-        if (neighbour) copy_neighbour(*neighbour, dx, dy, dz, *block);
+        out.chunks[static_cast<std::size_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1))] =
+            chunk({key.x + dx, key.y + dy, key.z + dz});
       }
-  return block;
+  return out;
 }
 
-void PaddedChunkReader::copy_neighbour(const storage::Chunk& chunk, int dx, int dy, int dz,
-                                       PaddedBlock& block) const {
-  // Per axis, the neighbour's voxels [from, to) that land in the padded block at local
-  // coordinate (its own coordinate + offset * 64): the last one before, all of it, or the
-  // first two after.
-  auto range = [](int offset, int32_t& from, int32_t& to) {
-    from = offset < 0 ? kChunkSize - 1 : 0;
-    to = offset > 0 ? 2 : kChunkSize;
-  };
-  int32_t x0 = 0, x1 = 0, y0 = 0, y1 = 0, z0 = 0, z1 = 0;
-  range(dx, x0, x1);
-  range(dy, y0, y1);
-  range(dz, z0, z1);
-  for (int32_t z = z0; z < z1; ++z)
-    for (int32_t y = y0; y < y1; ++y) {
-      const uint32_t* source = chunk.voxels.data() + storage::Chunk::index(x0, y, z);
-      uint32_t* target =
-          block.voxels.data() +
-          PaddedBlock::index(x0 + dx * kChunkSize, y + dy * kChunkSize, z + dz * kChunkSize);
-      std::memcpy(target, source, static_cast<std::size_t>(x1 - x0) * sizeof(uint32_t));
-    }
+void fill_padded_block(const ChunkNeighbourhood& neighbourhood, PaddedBlock& block) {
+  block.key = neighbourhood.key;
+  // Every voxel of the block is written below (a copy or a zero); the voxels before -1 and
+  // after 65 do not exist, so no clearing of the whole block is needed.
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const auto& neighbour =
+            neighbourhood.chunks[static_cast<std::size_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1))];
+        copy_neighbour(neighbour.get(), dx, dy, dz, block);
+      }
 }
 
 }  // namespace featsense::mesh::internal

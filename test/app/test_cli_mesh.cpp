@@ -114,5 +114,22 @@ TEST(CliMesh, ErrorsAreClear) {
   }
 }
 
+TEST(CliBenchMesh, PrintsTheFigures) {
+  const std::filesystem::path dir = scratch_dir("cli_bench_mesh");
+  const std::string json = (dir / "bench.json").string();
+  const CommandResult result =
+      run_featsense("bench mesh --map 10x10x4 --repeat 2 --threads 1 --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  nlohmann::json figures;
+  std::ifstream(json) >> figures;
+  for (const char* key : {"median_ms", "p95_ms", "max_ms", "voxels", "triangles", "voxels_per_s",
+                          "triangles_per_s", "threads"}) {
+    EXPECT_TRUE(figures.contains(key)) << key;
+  }
+  EXPECT_EQ(figures["threads"].get<int>(), 1);
+  EXPECT_GT(figures["triangles"].get<size_t>(), 10000u);
+  EXPECT_GT(figures["triangles_per_s"].get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace featsense::test

@@ -200,6 +200,20 @@ TEST(MarchingCubes, BoundingBoxCrops) {
   for (const Eigen::Vector3f& v : cropped.vertices) EXPECT_LE(v.z(), 0.3 + 1e-6);
   EXPECT_GT(count_edges(cropped).boundary, 0u);  // the cut is open
 
+  // Bounds off the 8-cube blocks the marcher skips by: the same vertices as the whole mesh,
+  // only those inside.
+  settings.bbox =
+      Eigen::AlignedBox3d(Eigen::Vector3d(-0.93, -1.71, -2), Eigen::Vector3d(1.17, 0.49, 2));
+  const mesh::TriangleMesh odd = mesh::extract_mesh(store, settings);
+  std::set<std::array<float, 3>> whole_vertices;
+  for (const Eigen::Vector3f& v : whole.vertices) whole_vertices.insert({v.x(), v.y(), v.z()});
+  ASSERT_GT(odd.triangles.size(), 1000u);
+  for (const Eigen::Vector3f& v : odd.vertices) {
+    EXPECT_TRUE(settings.bbox->contains(v.cast<double>()));
+    EXPECT_EQ(whole_vertices.count({v.x(), v.y(), v.z()}), 1u);
+  }
+  EXPECT_EQ(count_edges(odd).non_manifold, 0u);
+
   settings.bbox = Eigen::AlignedBox3d(Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(6, 6, 6));
   mesh::MeshingStats stats;
   EXPECT_TRUE(mesh::extract_mesh(store, settings, &stats).triangles.empty());

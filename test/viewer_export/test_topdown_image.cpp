@@ -24,13 +24,15 @@ struct DecodedPng {
 };
 
 uint32_t read_u32(const std::vector<uint8_t>& b, size_t at) {
-  return (uint32_t{b[at]} << 24) | (uint32_t{b[at + 1]} << 16) | (uint32_t{b[at + 2]} << 8) | b[at + 3];
+  return (uint32_t{b[at]} << 24) | (uint32_t{b[at + 1]} << 16) | (uint32_t{b[at + 2]} << 8) |
+         b[at + 3];
 }
 
 /// A minimal decoder for what the writer makes: 8-bit RGBA, filter 0 rows, checked CRCs.
 DecodedPng decode(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  const std::vector<uint8_t> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<uint8_t> b((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
   const std::vector<uint8_t> signature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   EXPECT_TRUE(std::equal(signature.begin(), signature.end(), b.begin()));
   DecodedPng png;
@@ -93,9 +95,9 @@ TEST(TopDownImage, HeightsBecomeColoursNorthUp) {
   const DecodedPng png = decode(path);
   ASSERT_EQ(png.width, 50u);
   ASSERT_EQ(png.height, 40u);
-  const uint8_t* floor = png.pixel(10, 20);     // x = 1.05 m, y = 1.95 m
-  const uint8_t* platform = png.pixel(40, 5);   // x = 4.05 m, y = 3.45 m: north is up
-  const uint8_t* gap = png.pixel(25, 20);       // x = 2.55 m: nothing there
+  const uint8_t* floor = png.pixel(10, 20);       // x = 1.05 m, y = 1.95 m
+  const uint8_t* platform = png.pixel(40, 5);     // x = 4.05 m, y = 3.45 m: north is up
+  const uint8_t* gap = png.pixel(25, 20);         // x = 2.55 m: nothing there
   const uint8_t* south_east = png.pixel(40, 35);  // below the platform: nothing
   EXPECT_EQ(floor[3], 255);
   EXPECT_EQ(platform[3], 255);

@@ -1,6 +1,7 @@
 #include "featsense/viewer_export/topdown_image.hpp"
 
 #include <zlib.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
@@ -17,12 +18,10 @@ namespace {
 /// A perceptually even blue-green-yellow ramp (control points of matplotlib's viridis,
 /// interpolated linearly), t in [0, 1].
 std::array<double, 3> height_colour(double t) {
-  static const double kStops[][3] = {{0.267, 0.005, 0.329}, {0.283, 0.141, 0.458},
-                                     {0.254, 0.265, 0.530}, {0.207, 0.372, 0.553},
-                                     {0.164, 0.471, 0.558}, {0.128, 0.567, 0.551},
-                                     {0.135, 0.659, 0.518}, {0.267, 0.749, 0.441},
-                                     {0.478, 0.821, 0.318}, {0.741, 0.873, 0.150},
-                                     {0.993, 0.906, 0.144}};
+  static const double kStops[][3] = {
+      {0.267, 0.005, 0.329}, {0.283, 0.141, 0.458}, {0.254, 0.265, 0.530}, {0.207, 0.372, 0.553},
+      {0.164, 0.471, 0.558}, {0.128, 0.567, 0.551}, {0.135, 0.659, 0.518}, {0.267, 0.749, 0.441},
+      {0.478, 0.821, 0.318}, {0.741, 0.873, 0.150}, {0.993, 0.906, 0.144}};
   constexpr int kSegments = 10;
   const double x = std::clamp(t, 0.0, 1.0) * kSegments;
   const int i = std::min(static_cast<int>(x), kSegments - 1);
@@ -120,9 +119,11 @@ TopDownImage write_topdown_png(const mesh::TriangleMesh& mesh, const std::string
                           (image.max_y_m - c.y()) * inv};
     const double area = (px[1] - px[0]) * (py[2] - py[0]) - (px[2] - px[0]) * (py[1] - py[0]);
     const int x0 = std::max(0, static_cast<int>(std::floor(std::min({px[0], px[1], px[2]}))));
-    const int x1 = std::min(image.width - 1, static_cast<int>(std::floor(std::max({px[0], px[1], px[2]}))));
+    const int x1 =
+        std::min(image.width - 1, static_cast<int>(std::floor(std::max({px[0], px[1], px[2]}))));
     const int y0 = std::max(0, static_cast<int>(std::floor(std::min({py[0], py[1], py[2]}))));
-    const int y1 = std::min(image.height - 1, static_cast<int>(std::floor(std::max({py[0], py[1], py[2]}))));
+    const int y1 =
+        std::min(image.height - 1, static_cast<int>(std::floor(std::max({py[0], py[1], py[2]}))));
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         const double cx = x + 0.5;
@@ -138,7 +139,8 @@ TopDownImage write_topdown_png(const mesh::TriangleMesh& mesh, const std::string
           if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
           z = w0 * a.z() + w1 * b.z() + w2 * c.z();
         }
-        const size_t i = static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x);
+        const size_t i =
+            static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x);
         if (z > top[i]) {
           top[i] = static_cast<float>(z);
           flatness[i] = nz;
@@ -155,8 +157,8 @@ TopDownImage write_topdown_png(const mesh::TriangleMesh& mesh, const std::string
     // Steep faces (walls seen from above) darker, so structures stand out from the floor.
     const double shade = 0.55 + 0.45 * flatness[i];
     for (int k = 0; k < 3; ++k) {
-      rgba[4 * i + static_cast<size_t>(k)] =
-          static_cast<uint8_t>(std::lround(255.0 * std::clamp(colour[static_cast<size_t>(k)] * shade, 0.0, 1.0)));
+      rgba[4 * i + static_cast<size_t>(k)] = static_cast<uint8_t>(
+          std::lround(255.0 * std::clamp(colour[static_cast<size_t>(k)] * shade, 0.0, 1.0)));
     }
     rgba[4 * i + 3] = 255;
   }

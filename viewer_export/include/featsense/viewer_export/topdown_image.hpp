@@ -17,9 +17,9 @@ struct TopDownImage {
   int width = 0;
   int height = 0;
   double pixel_size_m = 0.0;
-  double min_x_m = 0.0;  ///< the left edge of the image, map frame
-  double max_y_m = 0.0;  ///< the top edge (north up: +y is up in the image)
-  double low_z_m = 0.0;  ///< the height of the first colour (2nd percentile of the vertices)
+  double min_x_m = 0.0;   ///< the left edge of the image, map frame
+  double max_y_m = 0.0;   ///< the top edge (north up: +y is up in the image)
+  double low_z_m = 0.0;   ///< the height of the first colour (2nd percentile of the vertices)
   double high_z_m = 0.0;  ///< the height of the last colour (98th percentile)
 };
 
