@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The main job on a fresh machine: installs what is missing, builds featsense and runs it on
-# its built-in example (an analytic recording; no input needed).
-# Usage: bash scripts/demo.sh [arguments for featsense info, e.g. a recording]
+# The main job on a fresh machine: installs what is missing, builds featsense and runs its
+# demo: a built-in scene simulated, mapped, meshed and compared with the truth.
+# Usage: bash scripts/demo.sh [arguments for featsense demo, e.g. --scene parking -o DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bash "$root/scripts/install-deps.sh"
 build="${FEATSENSE_BUILD_DIR:-$root/build}"
 cmake -S "$root" -B "$build" -G Ninja > /dev/null
 cmake --build "$build" --parallel "$(nproc)" --target featsense
-"$build/app/featsense" info "$@"
+"$build/app/featsense" demo "$@"
