@@ -176,6 +176,7 @@ std::vector<KeySpec> make_specs() {
       vec3_key("map.size", &Config::map, &MapConfig::size_m, {1.0, 2000.0}),
       number_key("map.shift_threshold", &Config::map, &MapConfig::shift_threshold_m,
                  {0.0, 1000.0, true}),
+      bool_key("map.vertical_interpolation", &Config::map, &MapConfig::vertical_interpolation),
       number_key("map.flush_interval", &Config::map, &MapConfig::flush_interval_s,
                  {1.0, 86400.0}),
       backend_key(),

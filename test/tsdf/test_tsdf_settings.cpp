@@ -1,0 +1,40 @@
+// The integrator's settings from the configuration and the sensor model.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "featsense/config/sensor_model.hpp"
+#include "featsense/tsdf/tsdf_settings.hpp"
+
+namespace featsense::tsdf {
+namespace {
+
+TEST(TsdfSettings, InterpolationFollowsTheSensorsBeamSpacingOrIsOff) {
+  const config::SensorModel os1 = config::sensor_preset("os1-128");
+  config::MapConfig map;
+  const TsdfSettings on = TsdfSettings::from_config(map, os1);
+  EXPECT_NEAR(on.interpolation_slope, std::tan(os1.vertical_fov_rad() / os1.beams), 1e-7);
+  const TsdfSettings vlp = TsdfSettings::from_config(map, config::sensor_preset("vlp16"));
+  EXPECT_GT(vlp.interpolation_slope, 5.0f * on.interpolation_slope) << "16 beams over 30 deg";
+  map.vertical_interpolation = false;
+  EXPECT_EQ(TsdfSettings::from_config(map, os1).interpolation_slope, 0.0f);
+}
+
+TEST(TsdfSettings, SizesAndWeightsComeFromTheMapConfig) {
+  config::MapConfig map;
+  map.voxel_size_m = 0.1;
+  map.truncation_m = 0.3;
+  map.max_weight = 20.0;
+  map.size_m = {8.0, 8.0, 4.0};
+  const TsdfSettings s = TsdfSettings::from_config(map, config::sensor_preset("os1-64"));
+  EXPECT_FLOAT_EQ(s.voxel_size_m, 0.1f);
+  EXPECT_FLOAT_EQ(s.truncation_m, 0.3f);
+  EXPECT_EQ(s.max_weight_fixed(), 20u * 64u);
+  // 80 voxels = 10 bricks -> 11 (odd); 40 voxels = 5 bricks.
+  EXPECT_EQ(s.map_dim().x, 88);
+  EXPECT_EQ(s.map_dim().z, 40);
+}
+
+}  // namespace
+}  // namespace featsense::tsdf
