@@ -1,12 +1,46 @@
 #include "scan_to_rays.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
+#include <vector>
 
 namespace featsense::app {
 namespace {
 
 tsdf::Vec3 to_vec(const Eigen::Vector3d& p) {
   return {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+}
+
+/// Whether the beam above or below disagrees in range by more than a surface facing the
+/// sensor at >= ~27 deg can explain (2 x range x the angle between the two beams).
+bool grazing_or_edge(const slam::Scan& scan, size_t i, size_t j) {
+  if (!scan.valid[j]) return false;
+  const float r = scan.xyz[i].norm();
+  const float rn = scan.xyz[j].norm();
+  if (!(r > 0.0f) || !(rn > 0.0f)) return false;
+  const float cos_angle = std::clamp(scan.xyz[i].dot(scan.xyz[j]) / (r * rn), -1.0f, 1.0f);
+  const float angle = std::acos(cos_angle);
+  constexpr float kMaxRangeStep = 2.0f;  // in units of range x angle: tan(27 deg) = 1 / 2
+  return std::abs(r - rn) > kMaxRangeStep * std::min(r, rn) * angle;
+}
+
+/// Per cell (row-major), 1 where the ray may interpolate vertically: the paper's band runs
+/// perpendicular to the ray towards the neighbouring beams, which fills the gap between scan
+/// lines on a surface facing the sensor but crosses a surface seen at a grazing angle (the
+/// ground far away) and a depth edge, giving cells on the far side of it the wrong sign.
+std::vector<uint8_t> interpolation_flags(const slam::Scan& scan) {
+  std::vector<uint8_t> flags(scan.size(), 1);
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      const size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      const bool above = row > 0 && grazing_or_edge(scan, i, scan.index(row - 1, col));
+      const bool below = row + 1 < scan.rows && grazing_or_edge(scan, i, scan.index(row + 1, col));
+      if (above || below) flags[i] = 0;
+    }
+  }
+  return flags;
 }
 
 }  // namespace
@@ -16,9 +50,12 @@ tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const Eigen::Isometry3d& T_m
   rays.origins_m.push_back(to_vec(T_map_sensor.translation()));
   rays.up = to_vec(T_map_sensor.linear().col(2));
   rays.endpoints_m.reserve(scan.valid_count());
+  rays.interpolate.reserve(scan.valid_count());
+  const std::vector<uint8_t> flags = interpolation_flags(scan);
   for (size_t i = 0; i < scan.size(); ++i) {
-    if (scan.valid[i])
-      rays.endpoints_m.push_back(to_vec(T_map_sensor * scan.xyz[i].cast<double>()));
+    if (!scan.valid[i]) continue;
+    rays.endpoints_m.push_back(to_vec(T_map_sensor * scan.xyz[i].cast<double>()));
+    rays.interpolate.push_back(flags[i]);
   }
   return rays;
 }
@@ -28,6 +65,8 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
   rays.up = to_vec(pose_at(0.0).linear().col(2));
   rays.endpoints_m.reserve(scan.valid_count());
   rays.origins_m.reserve(scan.valid_count());
+  rays.interpolate.reserve(scan.valid_count());
+  const std::vector<uint8_t> flags = interpolation_flags(scan);
   for (int col = 0; col < scan.cols; ++col) {
     // All rows of a column share the column's time in the layout of scan.hpp; take the time
     // of the first valid point so sources with per-point times are honoured per column.
@@ -38,6 +77,7 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
       if (!pose) pose = pose_at(static_cast<double>(scan.time_offset_s[i]));
       rays.endpoints_m.push_back(to_vec(*pose * scan.xyz[i].cast<double>()));
       rays.origins_m.push_back(to_vec(pose->translation()));
+      rays.interpolate.push_back(flags[i]);
     }
   }
   return rays;

@@ -47,7 +47,9 @@ class BruteForceIntegrator {
         continue;
       }
       ++stats.rays;
-      detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params,
+      detail::RayMarchParams ray_params = params;
+      if (!rays.may_interpolate(i)) ray_params.interpolation_slope = 0.0f;
+      detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray_params,
                         [&](size_t index, int32_t value, bool interpolated) {
                           if (candidates_[index] == kEmptyCandidate) touched.push_back(index);
                           candidates_[index] =
@@ -168,6 +170,21 @@ TEST(CpuIntegratorExact, EveryRayWithInterpolation) {
   s.interpolation_slope = os1_interpolation_slope();
   EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(2, false)),
             0x632eb59c678b29bdull);
+}
+
+TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
+  TsdfSettings s;
+  s.map_size_m = {24.0f, 24.0f, 8.0f};
+  s.interpolation_slope = os1_interpolation_slope();
+  std::vector<RayBatch> scans = box_room_rays(2, false);
+  for (RayBatch& scan : scans) {
+    // Every third ray without interpolation: the flag, not a pattern of the scan, decides.
+    scan.interpolate.resize(scan.size());
+    for (size_t i = 0; i < scan.size(); ++i) scan.interpolate[i] = i % 3 == 0 ? 0 : 1;
+  }
+  const uint64_t flagged = expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans);
+  for (RayBatch& scan : scans) scan.interpolate.clear();
+  EXPECT_NE(flagged, expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans));
 }
 
 TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {

@@ -112,6 +112,12 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceOnAMovingSensor) {
   s.reduce_points_per_voxel = false;
   s.map_size_m = {12.0f, 12.0f, 6.0f};  // rays leave this map: clipping is exercised too
   expect_same_map(s, scans, "box room, small map, every ray");
+  std::vector<RayBatch> flagged = scans;
+  for (RayBatch& scan : flagged) {
+    scan.interpolate.resize(scan.size());
+    for (size_t i = 0; i < scan.size(); ++i) scan.interpolate[i] = i % 3 == 0 ? 0 : 1;
+  }
+  expect_same_map(s, flagged, "box room, small map, every third ray not interpolating");
 }
 
 TEST(CudaIntegrator, ReportsItsDeviceMemory) {

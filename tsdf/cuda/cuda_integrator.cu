@@ -73,13 +73,17 @@ struct ProposeCandidate {
 };
 
 __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
-                                const uint32_t* kept, const uint32_t* kept_count,
-                                detail::RayMarchParams params, ProposeCandidate propose) {
+                                const uint8_t* interpolate, const uint32_t* kept,
+                                const uint32_t* kept_count, detail::RayMarchParams params,
+                                ProposeCandidate propose) {
   const uint32_t count = *kept_count;
+  detail::RayMarchParams flat = params;
+  flat.interpolation_slope = 0.0f;
   for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
     const uint32_t i = kept[k];
-    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, params,
-                      propose);
+    const bool may_interpolate = interpolate == nullptr || interpolate[i] != 0;
+    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map,
+                      may_interpolate ? params : flat, propose);
   }
 }
 
@@ -155,7 +159,7 @@ class CudaIntegrator final : public Integrator {
   size_t memory_bytes() const override {
     return map_.bytes() + candidates_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
            kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
-           brick_offsets_.bytes() + brick_staging_.bytes();
+           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -230,9 +234,10 @@ class CudaIntegrator final : public Integrator {
     params.up = rays.up;
     const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
                                    touched_bricks_.data(), touched_count};
-    min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(origins_.data(), origin_per_point,
-                                                             endpoints_.data(), kept_.data(),
-                                                             kept_count, params, propose);
+    const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
+    min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
+        origins_.data(), origin_per_point, endpoints_.data(), interpolate, kept_.data(), kept_count,
+        params, propose);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
@@ -262,6 +267,13 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(origins_.data(), staging_.data() + n,
                                          origin_count * sizeof(Vec3), cudaMemcpyHostToDevice,
                                          stream_));
+    if (!rays.interpolate.empty()) {
+      interpolate_staging_.reserve(n);
+      interpolate_.reserve(n);
+      std::memcpy(interpolate_staging_.data(), rays.interpolate.data(), n);
+      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(interpolate_.data(), interpolate_staging_.data(), n,
+                                           cudaMemcpyHostToDevice, stream_));
+    }
   }
 
   void fill_identity(uint32_t n, uint32_t* kept_count);
@@ -301,6 +313,8 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<Vec3> endpoints_;
   cuda::DeviceBuffer<Vec3> origins_;
   cuda::PinnedBuffer<Vec3> staging_;
+  cuda::DeviceBuffer<uint8_t> interpolate_;  ///< per end point, when the batch has flags
+  cuda::PinnedBuffer<uint8_t> interpolate_staging_;
   // Moving the map: the storage offsets of a batch of bricks and their voxels.
   mutable std::vector<uint64_t> host_offsets_;
   mutable cuda::DeviceBuffer<uint64_t> brick_offsets_;

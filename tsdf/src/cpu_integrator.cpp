@@ -303,8 +303,11 @@ class CpuIntegrator final : public Integrator {
         part.handed_over[owner].push_back({index, key});
       }
     };
+    detail::RayMarchParams flat = params;
+    flat.interpolation_slope = 0.0f;
     for (const uint32_t i : ray_ids) {
-      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, params, propose);
+      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_,
+                       rays.may_interpolate(i) ? params : flat, propose);
     }
   }
 
