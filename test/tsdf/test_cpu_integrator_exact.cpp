@@ -16,7 +16,7 @@
 #include <unordered_set>
 
 #include "analytic_rays.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "box_room_rays.hpp"
 #include "ray_marcher.hpp"
 #include "tsdf_test_support.hpp"
 
@@ -81,37 +81,6 @@ uint64_t fnv1a(uint64_t hash, uint64_t word) {
   return hash * 0x100000001b3ull;
 }
 
-/// Scans of the box room with per-point origins (deskewed), as `featsense bench tsdf` builds
-/// them; `outdoor` is its 120 x 80 m yard open to the sky.
-std::vector<RayBatch> box_room_rays(int frames, bool outdoor) {
-  slam::BoxRoomSettings settings = slam::default_box_room();
-  settings.frames = frames;
-  settings.velocity_mps = Eigen::Vector3d(1.5, 0.5, 0.1);
-  if (outdoor) {
-    settings.room_min_m = Eigen::Vector3d(-60, -40, 0);
-    settings.room_max_m = Eigen::Vector3d(60, 40, 1e4);
-    settings.velocity_mps = Eigen::Vector3d(5, 0.3, 0);
-  }
-  auto source = slam::make_box_room_source(settings);
-  std::vector<RayBatch> batches;
-  int frame = 0;
-  while (auto scan = source->next()) {
-    RayBatch rays;
-    for (size_t i = 0; i < scan->size(); ++i) {
-      if (!scan->valid[i]) continue;
-      const double t = frame / settings.sensor.rate_hz + scan->time_offset_s[i];
-      const Eigen::Isometry3d pose = slam::box_room_pose(settings, t);
-      const Eigen::Vector3d p = pose * scan->xyz[i].cast<double>();
-      rays.endpoints_m.push_back(test::make_vec(p.x(), p.y(), p.z()));
-      const Eigen::Vector3d o = pose.translation();
-      rays.origins_m.push_back(test::make_vec(o.x(), o.y(), o.z()));
-    }
-    batches.push_back(std::move(rays));
-    ++frame;
-  }
-  return batches;
-}
-
 /// Integrates `scans` with the CPU integrator and the brute-force one, expects the same map
 /// and stats after every scan, and returns a hash of the CPU integrator's maps and stats.
 uint64_t expect_same_as_brute_force(const TsdfSettings& settings, Vec3 centre_m,
@@ -144,15 +113,16 @@ float os1_interpolation_slope() {
 TEST(CpuIntegratorExact, IndoorDefaultMapInterpolationReduction) {
   TsdfSettings s;  // the default 40 x 40 x 15 m map at 6.4 cm, as the pipeline uses it
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(3, false)),
-            0xba8163921710b792ull);
+  EXPECT_EQ(
+      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, false)),
+      0xba8163921710b792ull);
 }
 
 TEST(CpuIntegratorExact, OutdoorRaysLeaveTheMap) {
   TsdfSettings s;
   s.map_size_m = {20.0f, 16.0f, 8.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(3, true)),
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, true)),
             0xa87b17339ba69ddeull);
 }
 
@@ -160,23 +130,25 @@ TEST(CpuIntegratorExact, EveryRayNoInterpolation) {
   TsdfSettings s;
   s.map_size_m = {24.0f, 24.0f, 8.0f};
   s.reduce_points_per_voxel = false;
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(2, false)),
-            0x16a901aaf4f50573ull);
+  EXPECT_EQ(
+      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
+      0x16a901aaf4f50573ull);
 }
 
 TEST(CpuIntegratorExact, EveryRayWithInterpolation) {
   TsdfSettings s = test::small_map_settings();
   s.reduce_points_per_voxel = false;
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), box_room_rays(2, false)),
-            0x632eb59c678b29bdull);
+  EXPECT_EQ(
+      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
+      0x632eb59c678b29bdull);
 }
 
 TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
   TsdfSettings s;
   s.map_size_m = {24.0f, 24.0f, 8.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  std::vector<RayBatch> scans = box_room_rays(2, false);
+  std::vector<RayBatch> scans = test::box_room_rays(2, false);
   for (RayBatch& scan : scans) {
     // Every third ray without interpolation: the flag, not a pattern of the scan, decides.
     scan.interpolate.resize(scan.size());
@@ -192,7 +164,7 @@ TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
   TsdfSettings s;
   s.map_size_m = {8.0f, 8.0f, 4.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), box_room_rays(2, false)),
+  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), test::box_room_rays(2, false)),
             0x4761511e2fed3bc0ull);
 }
 
@@ -203,7 +175,7 @@ TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
   TsdfSettings s;
   s.map_size_m = {16.0f, 16.0f, 6.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  const std::vector<RayBatch> scans = box_room_rays(2, false);
+  const std::vector<RayBatch> scans = test::box_room_rays(2, false);
   for (const int threads : {1, 7}) {
     tbb::task_arena arena(threads);
     arena.execute([&] {

@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "analytic_rays.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "box_room_rays.hpp"
 #include "tsdf_test_support.hpp"
 
 namespace featsense::tsdf {
@@ -36,31 +36,6 @@ Difference compare(const std::vector<uint32_t>& a, const std::vector<uint32_t>& 
     d.max_weight_units = std::max(d.max_weight_units, std::abs(x.weight - y.weight));
   }
   return d;
-}
-
-/// Scans of the moving box room as rays: per-point origins from the true motion.
-std::vector<RayBatch> box_room_rays(int frames) {
-  slam::BoxRoomSettings settings = slam::default_box_room();
-  settings.frames = frames;
-  settings.velocity_mps = Eigen::Vector3d(1.5, 0.5, 0.1);
-  auto source = slam::make_box_room_source(settings);
-  std::vector<RayBatch> batches;
-  int frame = 0;
-  while (auto scan = source->next()) {
-    RayBatch rays;
-    for (size_t i = 0; i < scan->size(); ++i) {
-      if (!scan->valid[i]) continue;
-      const double t = frame / settings.sensor.rate_hz + scan->time_offset_s[i];
-      const Eigen::Isometry3d pose = slam::box_room_pose(settings, t);
-      const Eigen::Vector3d p = pose * scan->xyz[i].cast<double>();
-      rays.endpoints_m.push_back(test::make_vec(p.x(), p.y(), p.z()));
-      const Eigen::Vector3d o = pose.translation();
-      rays.origins_m.push_back(test::make_vec(o.x(), o.y(), o.z()));
-    }
-    batches.push_back(std::move(rays));
-    ++frame;
-  }
-  return batches;
 }
 
 void expect_same_map(const TsdfSettings& settings, const std::vector<RayBatch>& scans,
@@ -105,7 +80,7 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceOnAnalyticSurfaces) {
 
 TEST(CudaIntegrator, SameMapAsTheCpuReferenceOnAMovingSensor) {
   SKIP_WITHOUT_GPU();
-  const std::vector<RayBatch> scans = box_room_rays(4);
+  const std::vector<RayBatch> scans = test::box_room_rays(4, false);
   TsdfSettings s;  // the default 40 x 40 x 15 m map at 6.4 cm
   s.interpolation_slope = static_cast<float>(std::tan(0.785398 / 128));
   expect_same_map(s, scans, "box room, default map, interpolation, reduction");

@@ -1,0 +1,44 @@
+#pragma once
+// Scans of the built-in box room as TSDF rays, for the tests that compare integrators.
+
+#include <vector>
+
+#include "analytic_rays.hpp"
+#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/tsdf/ray_batch.hpp"
+
+namespace featsense::tsdf::test {
+
+/// `frames` scans of an OS1-128 moving through the box room (per-point origins from the true
+/// motion, so the rays of one scan start at many points); `outdoor` is its 120 x 80 m yard
+/// open to the sky, where rays leave the map.
+inline std::vector<RayBatch> box_room_rays(int frames, bool outdoor) {
+  slam::BoxRoomSettings settings = slam::default_box_room();
+  settings.frames = frames;
+  settings.velocity_mps = Eigen::Vector3d(1.5, 0.5, 0.1);
+  if (outdoor) {
+    settings.room_min_m = Eigen::Vector3d(-60, -40, 0);
+    settings.room_max_m = Eigen::Vector3d(60, 40, 1e4);
+    settings.velocity_mps = Eigen::Vector3d(5, 0.3, 0);
+  }
+  auto source = slam::make_box_room_source(settings);
+  std::vector<RayBatch> batches;
+  int frame = 0;
+  while (auto scan = source->next()) {
+    RayBatch rays;
+    for (size_t i = 0; i < scan->size(); ++i) {
+      if (!scan->valid[i]) continue;
+      const double t = frame / settings.sensor.rate_hz + scan->time_offset_s[i];
+      const Eigen::Isometry3d pose = slam::box_room_pose(settings, t);
+      const Eigen::Vector3d p = pose * scan->xyz[i].cast<double>();
+      rays.endpoints_m.push_back(make_vec(p.x(), p.y(), p.z()));
+      const Eigen::Vector3d o = pose.translation();
+      rays.origins_m.push_back(make_vec(o.x(), o.y(), o.z()));
+    }
+    batches.push_back(std::move(rays));
+    ++frame;
+  }
+  return batches;
+}
+
+}  // namespace featsense::tsdf::test
