@@ -58,7 +58,13 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
 }
 
 void run_demo(const DemoOptions& options, const CliContext& context) {
-  context.load_config();  // bad --config / --set fail before the simulation
+  MapOptions map;
+  map.output = options.output;
+  map.backend = options.backend;
+  map.overwrite = true;  // the demo's own folder: a second demo replaces the first
+  map.print_summary = false;
+  // Bad --config / --set fail before the simulation.
+  const config::Config config = map_config(map, context);
   SimulateOptions simulate;
   simulate.scene = options.scene;
   simulate.path = options.path;
@@ -70,16 +76,12 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   SimulatedScanSource source(simulation,
                              "built-in scene " + options.scene + ", " + options.path + " path",
                              truth.string());
-  MapOptions map;
-  map.output = options.output;
-  map.backend = options.backend;
-  map.overwrite = true;  // the demo's own folder: a second demo replaces the first
-  map.print_summary = false;
+
   MeshReferences references;
   references.surface = truth / "gt_mesh.ply";
   references.seen = truth / "gt_points.ply";
   const MapOutcome outcome =
-      map_recording(source, simulation.frame_poses(), map, references, context);
+      map_recording(source, simulation.frame_poses(), map, config, references, context);
   if (!context.quiet) print_summary(options, outcome);
 }
 

@@ -111,14 +111,13 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   }
   frame_range(options);  // bad --start / --end fail before the recording is opened
   std::unique_ptr<slam::ScanSource> source = options.input.open(config);
-  return map_recording(*source, read_poses(options), options,
+  return map_recording(*source, read_poses(options), options, config,
                        find_mesh_references(options.input.input, options.reference), context);
 }
 
 MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
-                         const MapOptions& options, const MeshReferences& references,
-                         const CliContext& context) {
-  config::Config config = map_config(options, context);
+                         const MapOptions& options, config::Config config,
+                         const MeshReferences& references, const CliContext& context) {
   const FrameRange range = frame_range(options);
   const slam::SourceInfo& info = source.info();
   std::unique_ptr<ScanLocator> locator =

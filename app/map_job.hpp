@@ -39,10 +39,15 @@ struct MapOutcome {
 /// Maps INPUT (opened with the run's configuration) with the poses of --gt into OUT.
 MapOutcome run_map(const MapOptions& options, const CliContext& context);
 
-/// Maps `source` with `poses` into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb, report.json).
-/// Throws ConfigError, InputError, Interrupted (after writing the outputs) or std::runtime_error.
+/// The run's configuration (defaults, --config, --set) with --backend applied. Throws
+/// ConfigError.
+config::Config map_config(const MapOptions& options, const CliContext& context);
+
+/// Maps `source` with `poses` and `config` (from map_config) into OUT (map.h5,
+/// trajectory.tum/.kitti, mesh.ply/.glb, report.json). Throws ConfigError, InputError, Interrupted
+/// (after writing the outputs) or std::runtime_error.
 MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
-                         const MapOptions& options, const MeshReferences& references,
-                         const CliContext& context);
+                         const MapOptions& options, config::Config config,
+                         const MeshReferences& references, const CliContext& context);
 
 }  // namespace featsense::app
