@@ -75,6 +75,16 @@ uint64_t chunk_digest(const Chunk& chunk) {
   return h ^ (h >> 31);
 }
 
+namespace {
+
+/// The digest of a chunk with nothing observed: what the store holds where it holds nothing.
+uint64_t empty_chunk_digest() {
+  static const uint64_t digest = chunk_digest(Chunk{});
+  return digest;
+}
+
+}  // namespace
+
 ShiftingMap::ShiftingMap(tsdf::Integrator& map, ChunkStore& store, double shift_threshold_m)
     : map_(map), store_(store), shift_threshold_m_(shift_threshold_m) {
   const double map_voxel = map_.geometry().voxel_size_m;
@@ -136,11 +146,10 @@ void ShiftingMap::sync() {
 
 template <typename VoxelsOf>
 void ShiftingMap::spill(const std::vector<Index3>& bricks, const VoxelsOf& voxels_of) {
-  static const uint64_t kEmptyDigest = chunk_digest(Chunk{});
   for (const auto& [key, members] : group_by_chunk(bricks)) {
     // Most of a local map is never observed: a whole chunk of such bricks where the store
     // holds nothing needs neither assembling nor writing.
-    if (members.size() == kBricksInChunk && unchanged_in_store(key, kEmptyDigest) &&
+    if (members.size() == kBricksInChunk && unchanged_in_store(key, empty_chunk_digest()) &&
         std::all_of(members.begin(), members.end(), [&](size_t k) {
           const uint32_t* voxels = voxels_of(k);
           return std::all_of(voxels, voxels + kBrickVoxels,
@@ -173,8 +182,7 @@ bool ShiftingMap::unchanged_in_store(const ChunkKey& key, uint64_t digest) const
   if (found != written_.end()) return found->second == digest;
   // Never written by this map: the store holds nothing there unless it did at open (whose
   // contents are unknown here), and nothing is what an empty chunk means.
-  static const uint64_t kEmptyDigest = chunk_digest(Chunk{});
-  return keys_at_open_.count(key) == 0 && digest == kEmptyDigest;
+  return keys_at_open_.count(key) == 0 && digest == empty_chunk_digest();
 }
 
 void ShiftingMap::load(const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
