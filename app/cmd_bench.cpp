@@ -101,7 +101,7 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
 struct BenchMeshOptions {
   std::string map_size = "40x40x15";
   double voxel_size_m = 0.064;
-  double truncation_m = 0.6;
+  double truncation_m = 0.25;
   int repeat = 7;
   int threads = 0;
   std::optional<std::string> json_path;

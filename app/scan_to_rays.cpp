@@ -43,6 +43,15 @@ std::vector<uint8_t> interpolation_flags(const slam::Scan& scan) {
   return flags;
 }
 
+/// The ray's place in the lattice of sparse carving (tsdf::TsdfSettings::dense_range_m): the
+/// largest L with both its beam and its column multiples of 2^L.
+uint8_t carving_level(int row, int col) {
+  const auto level = [](int index) {
+    return index == 0 ? int{tsdf::kFullCarvingLevel} : __builtin_ctz(static_cast<unsigned>(index));
+  };
+  return static_cast<uint8_t>(std::min({level(row), level(col), int{tsdf::kFullCarvingLevel}}));
+}
+
 }  // namespace
 
 tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const Eigen::Isometry3d& T_map_sensor) {
@@ -51,11 +60,16 @@ tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const Eigen::Isometry3d& T_m
   rays.up = to_vec(T_map_sensor.linear().col(2));
   rays.endpoints_m.reserve(scan.valid_count());
   rays.interpolate.reserve(scan.valid_count());
+  rays.carving_level.reserve(scan.valid_count());
   const std::vector<uint8_t> flags = interpolation_flags(scan);
-  for (size_t i = 0; i < scan.size(); ++i) {
-    if (!scan.valid[i]) continue;
-    rays.endpoints_m.push_back(to_vec(T_map_sensor * scan.xyz[i].cast<double>()));
-    rays.interpolate.push_back(flags[i]);
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      const size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      rays.endpoints_m.push_back(to_vec(T_map_sensor * scan.xyz[i].cast<double>()));
+      rays.interpolate.push_back(flags[i]);
+      rays.carving_level.push_back(carving_level(row, col));
+    }
   }
   return rays;
 }
@@ -66,6 +80,7 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
   rays.endpoints_m.reserve(scan.valid_count());
   rays.origins_m.reserve(scan.valid_count());
   rays.interpolate.reserve(scan.valid_count());
+  rays.carving_level.reserve(scan.valid_count());
   const std::vector<uint8_t> flags = interpolation_flags(scan);
   for (int col = 0; col < scan.cols; ++col) {
     // All rows of a column share the column's time in the layout of scan.hpp; take the time
@@ -78,6 +93,7 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
       rays.endpoints_m.push_back(to_vec(*pose * scan.xyz[i].cast<double>()));
       rays.origins_m.push_back(to_vec(pose->translation()));
       rays.interpolate.push_back(flags[i]);
+      rays.carving_level.push_back(carving_level(row, col));
     }
   }
   return rays;

@@ -177,6 +177,7 @@ std::vector<KeySpec> make_specs() {
       number_key("map.shift_threshold", &Config::map, &MapConfig::shift_threshold_m,
                  {0.0, 1000.0, true}),
       bool_key("map.vertical_interpolation", &Config::map, &MapConfig::vertical_interpolation),
+      bool_key("map.sparse_carving", &Config::map, &MapConfig::sparse_carving),
       number_key("map.flush_interval", &Config::map, &MapConfig::flush_interval_s, {1.0, 86400.0}),
       backend_key(),
       integer_key("odometry.optimization_steps", &Config::odometry,

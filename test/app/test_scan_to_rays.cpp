@@ -58,5 +58,49 @@ TEST(ScanToRays, DepthEdgesDoNotInterpolateAcrossTheGap) {
   }
 }
 
+TEST(ScanToRays, CarvingLevelsFormALatticeOfBeamsAndColumns) {
+  // 8 x 8 cells, all valid but (2, 4): each ray's level is the largest L with its beam and
+  // its column multiples of 2^L, and both conversions give the same levels to the same cells.
+  slam::Scan scan = slam::Scan::allocate(8, 8);
+  for (int row = 0; row < 8; ++row) {
+    for (int col = 0; col < 8; ++col) {
+      if (row == 2 && col == 4) continue;
+      const size_t i = scan.index(row, col);
+      scan.valid[i] = 1;
+      scan.xyz[i] =
+          Eigen::Vector3f(5.0f, 0.1f * static_cast<float>(col), 0.1f * static_cast<float>(row));
+      scan.range_m[i] = scan.xyz[i].norm();
+      scan.time_offset_s[i] = 0.01f * static_cast<float>(col);
+    }
+  }
+  const auto expected = [](int row, int col) -> int {
+    if (row == 0 && col == 0) return tsdf::kFullCarvingLevel;
+    int level = 0;
+    while (row % (2 << level) == 0 && col % (2 << level) == 0) ++level;
+    return level;
+  };
+  const tsdf::RayBatch rays = scan_to_rays(scan, Eigen::Isometry3d::Identity());
+  ASSERT_EQ(rays.carving_level.size(), 63u);
+  const tsdf::RayBatch deskewed =
+      deskewed_scan_to_rays(scan, [](double) { return Eigen::Isometry3d::Identity(); });
+  ASSERT_EQ(deskewed.carving_level.size(), 63u);
+  size_t k = 0;
+  for (int row = 0; row < 8; ++row) {
+    for (int col = 0; col < 8; ++col) {
+      if (row == 2 && col == 4) continue;
+      EXPECT_EQ(rays.carving_level[k++], expected(row, col)) << row << ", " << col;
+    }
+  }
+  k = 0;
+  for (int col = 0; col < 8; ++col) {  // the deskewed rays come column by column
+    for (int row = 0; row < 8; ++row) {
+      if (row == 2 && col == 4) continue;
+      EXPECT_EQ(deskewed.carving_level[k++], expected(row, col)) << row << ", " << col;
+    }
+  }
+  EXPECT_EQ(rays.carving_level[0], tsdf::kFullCarvingLevel);
+  EXPECT_EQ(rays.carving_level[4 * 8 + 4 - 1], 2) << "(4, 4)";  // one cell before is missing
+}
+
 }  // namespace
 }  // namespace featsense::app

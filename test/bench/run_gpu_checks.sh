@@ -44,6 +44,19 @@ if [ "$what" = bench ] || [ "$what" = all ]; then
       --json "$out/bench_store_${backend}.json" > /dev/null &&
       summary "$out/bench_store_${backend}.json" "store shift 10 m" slab_mb sync_s checkpoint_s file_mb
   done
+  # What the defaults of the truncation and the sparse carving each change, on the CUDA backend.
+  for variant in "old map.truncation=0.6 map.sparse_carving=false" "full map.sparse_carving=false"; do
+    set -- $variant; name=$1; shift
+    sets=(); for kv in "$@"; do sets+=(--set "$kv"); done
+    for scene in indoor outdoor; do
+      "$bin/featsense" bench tsdf --quiet --backend cuda --scene "$scene" --repeat 200 "${sets[@]}" \
+        --json "$out/bench_tsdf_cuda_${scene}_$name.json" > /dev/null &&
+        summary "$out/bench_tsdf_cuda_${scene}_$name.json" "tsdf $scene ($*)"
+    done
+    "$bin/featsense" bench tsdf --quiet --backend cuda --repeat 200 --input "$pcap" --meta "$meta" "${sets[@]}" \
+      --json "$out/bench_tsdf_cuda_os1_$name.json" > /dev/null &&
+      summary "$out/bench_tsdf_cuda_os1_$name.json" "tsdf os1-real ($*)"
+  done
 fi
 
 if [ "$what" = map ] || [ "$what" = all ]; then

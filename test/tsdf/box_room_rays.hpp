@@ -9,10 +9,19 @@
 
 namespace featsense::tsdf::test {
 
+/// The carving level of the ray of (row, col), counted here by hand: the largest L with both
+/// multiples of 2^L.
+inline uint8_t lattice_level(int row, int col) {
+  int level = 0;
+  while (level < kFullCarvingLevel && row % (2 << level) == 0 && col % (2 << level) == 0) ++level;
+  return static_cast<uint8_t>(level);
+}
+
 /// `frames` scans of an OS1-128 moving through the box room (per-point origins from the true
 /// motion, so the rays of one scan start at many points); `outdoor` is its 120 x 80 m yard
-/// open to the sky, where rays leave the map.
-inline std::vector<RayBatch> box_room_rays(int frames, bool outdoor) {
+/// open to the sky, where rays leave the map. With `carving_levels`, each ray carries its
+/// place in the lattice of sparse carving.
+inline std::vector<RayBatch> box_room_rays(int frames, bool outdoor, bool carving_levels = false) {
   slam::BoxRoomSettings settings = slam::default_box_room();
   settings.frames = frames;
   settings.velocity_mps = Eigen::Vector3d(1.5, 0.5, 0.1);
@@ -34,6 +43,9 @@ inline std::vector<RayBatch> box_room_rays(int frames, bool outdoor) {
       rays.endpoints_m.push_back(make_vec(p.x(), p.y(), p.z()));
       const Eigen::Vector3d o = pose.translation();
       rays.origins_m.push_back(make_vec(o.x(), o.y(), o.z()));
+      const int row = static_cast<int>(i) / scan->cols;
+      if (carving_levels)
+        rays.carving_level.push_back(lattice_level(row, static_cast<int>(i) % scan->cols));
     }
     batches.push_back(std::move(rays));
     ++frame;

@@ -49,6 +49,8 @@ class BruteForceIntegrator {
       ++stats.rays;
       detail::RayMarchParams ray_params = params;
       if (!rays.may_interpolate(i)) ray_params.interpolation_slope = 0.0f;
+      ray_params.carve_from_m =
+          detail::carving_start(settings_.dense_range_m, rays.carving_level_of(i));
       detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray_params,
                         [&](size_t index, int32_t value, bool interpolated) {
                           if (candidates_[index] == kEmptyCandidate) touched.push_back(index);
@@ -110,8 +112,15 @@ float os1_interpolation_slope() {
   return static_cast<float>(std::tan(os1.vertical_fov_rad() / os1.beams));
 }
 
+/// The settings the hashes were recorded with: the default map, tau 0.6 m.
+TsdfSettings settings_of_the_hashes() {
+  TsdfSettings s;
+  s.truncation_m = 0.6f;
+  return s;
+}
+
 TEST(CpuIntegratorExact, IndoorDefaultMapInterpolationReduction) {
-  TsdfSettings s;  // the default 40 x 40 x 15 m map at 6.4 cm, as the pipeline uses it
+  TsdfSettings s = settings_of_the_hashes();  // the 40 x 40 x 15 m map at 6.4 cm
   s.interpolation_slope = os1_interpolation_slope();
   EXPECT_EQ(
       expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, false)),
@@ -119,7 +128,7 @@ TEST(CpuIntegratorExact, IndoorDefaultMapInterpolationReduction) {
 }
 
 TEST(CpuIntegratorExact, OutdoorRaysLeaveTheMap) {
-  TsdfSettings s;
+  TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {20.0f, 16.0f, 8.0f};
   s.interpolation_slope = os1_interpolation_slope();
   EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, true)),
@@ -127,7 +136,7 @@ TEST(CpuIntegratorExact, OutdoorRaysLeaveTheMap) {
 }
 
 TEST(CpuIntegratorExact, EveryRayNoInterpolation) {
-  TsdfSettings s;
+  TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {24.0f, 24.0f, 8.0f};
   s.reduce_points_per_voxel = false;
   EXPECT_EQ(
@@ -145,7 +154,7 @@ TEST(CpuIntegratorExact, EveryRayWithInterpolation) {
 }
 
 TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
-  TsdfSettings s;
+  TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {24.0f, 24.0f, 8.0f};
   s.interpolation_slope = os1_interpolation_slope();
   std::vector<RayBatch> scans = test::box_room_rays(2, false);
@@ -159,9 +168,21 @@ TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
   EXPECT_NE(flagged, expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans));
 }
 
+TEST(CpuIntegratorExact, SparseCarving) {
+  // Rays of the lattice carve nearer the sensor than the others, each walk ends where its
+  // level says: the CPU walk must end where march_ray does, on a map rays also leave.
+  TsdfSettings s = TsdfSettings::from_config(config::MapConfig{}, config::sensor_preset("os1-128"));
+  ASSERT_GT(s.dense_range_m, 1.0f);
+  s.map_size_m = {24.0f, 24.0f, 8.0f};
+  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+  s.dense_range_m *= 4.0f;  // most of the room within the dense range
+  s.reduce_points_per_voxel = false;
+  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+}
+
 TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
   // A 8 x 8 x 4 m map ahead of the sensor: rays enter it from outside, some only pass it.
-  TsdfSettings s;
+  TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {8.0f, 8.0f, 4.0f};
   s.interpolation_slope = os1_interpolation_slope();
   EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), test::box_room_rays(2, false)),
@@ -172,7 +193,7 @@ TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
   // The CPU integrator shares the map out among sectors by its thread count: one thread
   // (four sectors) and seven (28 sectors, more candidates handed between them) must give the
   // same map as the brute-force integrator.
-  TsdfSettings s;
+  TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {16.0f, 16.0f, 6.0f};
   s.interpolation_slope = os1_interpolation_slope();
   const std::vector<RayBatch> scans = test::box_room_rays(2, false);

@@ -73,7 +73,8 @@ struct ProposeCandidate {
 };
 
 __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
-                                const uint8_t* interpolate, const uint32_t* kept,
+                                const uint8_t* interpolate, const uint8_t* carving_level,
+                                float dense_range_m, const uint32_t* kept,
                                 const uint32_t* kept_count, detail::RayMarchParams params,
                                 ProposeCandidate propose) {
   const uint32_t count = *kept_count;
@@ -82,8 +83,10 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
   for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
     const uint32_t i = kept[k];
     const bool may_interpolate = interpolate == nullptr || interpolate[i] != 0;
-    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map,
-                      may_interpolate ? params : flat, propose);
+    detail::RayMarchParams ray = may_interpolate ? params : flat;
+    ray.carve_from_m = detail::carving_start(
+        dense_range_m, carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
+    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose);
   }
 }
 
@@ -159,7 +162,8 @@ class CudaIntegrator final : public Integrator {
   size_t memory_bytes() const override {
     return map_.bytes() + candidates_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
            kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
-           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes();
+           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes() +
+           carving_level_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -235,9 +239,10 @@ class CudaIntegrator final : public Integrator {
     const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
                                    touched_bricks_.data(), touched_count};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
+    const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
-        origins_.data(), origin_per_point, endpoints_.data(), interpolate, kept_.data(), kept_count,
-        params, propose);
+        origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
+        settings_.dense_range_m, kept_.data(), kept_count, params, propose);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
@@ -272,6 +277,13 @@ class CudaIntegrator final : public Integrator {
       interpolate_.reserve(n);
       std::memcpy(interpolate_staging_.data(), rays.interpolate.data(), n);
       FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(interpolate_.data(), interpolate_staging_.data(), n,
+                                           cudaMemcpyHostToDevice, stream_));
+    }
+    if (!rays.carving_level.empty()) {
+      carving_level_staging_.reserve(n);
+      carving_level_.reserve(n);
+      std::memcpy(carving_level_staging_.data(), rays.carving_level.data(), n);
+      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(carving_level_.data(), carving_level_staging_.data(), n,
                                            cudaMemcpyHostToDevice, stream_));
     }
   }
@@ -315,6 +327,8 @@ class CudaIntegrator final : public Integrator {
   cuda::PinnedBuffer<Vec3> staging_;
   cuda::DeviceBuffer<uint8_t> interpolate_;  ///< per end point, when the batch has flags
   cuda::PinnedBuffer<uint8_t> interpolate_staging_;
+  cuda::DeviceBuffer<uint8_t> carving_level_;  ///< per end point, when the batch has levels
+  cuda::PinnedBuffer<uint8_t> carving_level_staging_;
   // Moving the map: the storage offsets of a batch of bricks and their voxels.
   mutable std::vector<uint64_t> host_offsets_;
   mutable cuda::DeviceBuffer<uint64_t> brick_offsets_;

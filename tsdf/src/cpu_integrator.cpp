@@ -306,8 +306,9 @@ class CpuIntegrator final : public Integrator {
     detail::RayMarchParams flat = params;
     flat.interpolation_slope = 0.0f;
     for (const uint32_t i : ray_ids) {
-      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_,
-                       rays.may_interpolate(i) ? params : flat, propose);
+      detail::RayMarchParams ray = rays.may_interpolate(i) ? params : flat;
+      ray.carve_from_m = detail::carving_start(settings_.dense_range_m, rays.carving_level_of(i));
+      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, propose);
     }
   }
 

@@ -38,7 +38,7 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
   const float vs = map.voxel_size_m;
   const Vec3 walk_start = origin + t1 * dir;
   const Vec3 walk_dir = -1.0f * dir;
-  const float walk_length = t1 - t0;
+  const float walk_length = t1 - walk_end(t0, range, params, vs);
   const Index3 start = map.voxel_of(walk_start);
   const Index3 start_brick = map.wrapped_brick(start);
   const Index3 start_local = LocalMapGeometry::local_in_brick(start);

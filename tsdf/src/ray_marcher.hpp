@@ -7,6 +7,7 @@
 #include <cfloat>
 
 #include "featsense/tsdf/local_map_geometry.hpp"
+#include "featsense/tsdf/ray_batch.hpp"
 #include "featsense/tsdf/vec3.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
@@ -18,7 +19,32 @@ struct RayMarchParams {
   /// range (paper eq. 7-8); 0 turns interpolation off.
   float interpolation_slope = 0.0f;
   Vec3 up{0.0f, 0.0f, 1.0f};  ///< the sensor's z axis in the map frame
+  /// Free space nearer to the ray's origin than this is left to other rays (sparse carving,
+  /// TsdfSettings::dense_range_m); 0 = the ray carves all the way to the sensor.
+  float carve_from_m = 0.0f;
 };
+
+/// Where a ray of carving level `level` starts to carve free space: dense_range / 2^level, so
+/// that at any distance the rays that carve there are at most half a voxel apart (0: all the
+/// way). A division by a power of two: exact, the same on host and device.
+FEATSENSE_HD_INLINE float carving_start(float dense_range_m, uint32_t level) {
+  if (!(dense_range_m > 0.0f) || level >= kFullCarvingLevel) return 0.0f;
+  return dense_range_m / static_cast<float>(1u << level);
+}
+
+/// Distance from the origin at which the walk back towards the sensor ends: where the ray
+/// enters the map, or, for a ray that carves only beyond carve_from_m, two voxels before
+/// that and before the truncation band. A voxel's centre is within 0.87 voxels of every
+/// point where the ray crosses it, so every voxel with its centre in the band is still
+/// visited, with the same candidate as by a full walk.
+FEATSENSE_HD_INLINE float walk_end(float t_enter, float range, const RayMarchParams& params,
+                                   float voxel_size_m) {
+  if (!(params.carve_from_m > 0.0f)) return t_enter;
+  const float band_start = range - params.truncation_m;
+  const float nearer = params.carve_from_m < band_start ? params.carve_from_m : band_start;
+  const float end = nearer - 2.0f * voxel_size_m;
+  return end > t_enter ? end : t_enter;
+}
 
 /// Clips the segment origin + t * dir, t in [t0, t1], to the box [lo, hi]; false if it misses.
 FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, float& t0,
@@ -71,7 +97,7 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
   const float vs = map.voxel_size_m;
   const Vec3 walk_start = origin + t1 * dir;
   const Vec3 walk_dir = -1.0f * dir;
-  const float walk_length = t1 - t0;
+  const float walk_length = t1 - walk_end(t0, range, params, vs);
   Index3 voxel = map.voxel_of(walk_start);
   int32_t step[3];
   float t_next[3];

@@ -1,11 +1,33 @@
 #include "featsense/tsdf/tsdf_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "featsense/tsdf/local_map_shift.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
 namespace featsense::tsdf {
+namespace {
+
+/// voxel / (4 x the coarsest angle between neighbouring rays): nearer than that, rays of
+/// every second beam and column are still at most half a voxel apart (TsdfSettings).
+/// 0 for a model without beams or columns.
+float dense_range(float voxel_size_m, const config::SensorModel& sensor) {
+  if (sensor.beams < 2 || sensor.columns < 1) return 0.0f;
+  constexpr double kPi = 3.14159265358979323846;
+  double widest = 2.0 * kPi / static_cast<double>(sensor.columns);
+  if (sensor.elevation_rad.size() == static_cast<size_t>(sensor.beams)) {
+    for (size_t b = 1; b < sensor.elevation_rad.size(); ++b) {
+      widest = std::max(widest, std::abs(sensor.elevation_rad[b - 1] - sensor.elevation_rad[b]));
+    }
+  } else {
+    widest = std::max(widest, sensor.vertical_fov_rad() / static_cast<double>(sensor.beams - 1));
+  }
+  if (!(widest > 0.0)) return 0.0f;
+  return static_cast<float>(static_cast<double>(voxel_size_m) / (4.0 * widest));
+}
+
+}  // namespace
 
 Index3 TsdfSettings::map_dim() const {
   int32_t dim[3];
@@ -37,6 +59,7 @@ TsdfSettings TsdfSettings::from_config(const config::MapConfig& map,
     s.interpolation_slope =
         static_cast<float>(std::tan(sensor.vertical_fov_rad() / static_cast<double>(sensor.beams)));
   }
+  if (map.sparse_carving) s.dense_range_m = dense_range(s.voxel_size_m, sensor);
   return s;
 }
 

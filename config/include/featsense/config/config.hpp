@@ -22,13 +22,16 @@ enum class Backend { kAuto, kCuda, kCpu };
 
 struct MapConfig {
   double voxel_size_m = 0.064;
-  double truncation_m = 0.6;
+  double truncation_m = 0.25;
   double max_weight = 10.0;
   std::array<double, 3> size_m = {40.0, 40.0, 15.0};
   double shift_threshold_m = 3.0;
   /// Fill the gap between neighbouring beams across each ray near the surface (paper eq. 7-8),
   /// except on rays whose neighbouring beams disagree in range (app/scan_to_rays.cpp).
   bool vertical_interpolation = true;
+  /// Near the sensor, where rays are much denser than voxels, only a lattice of them carves
+  /// free space (TsdfSettings::dense_range_m).
+  bool sparse_carving = true;
   /// Seconds between two writes of the local map into the store during a run.
   double flush_interval_s = 30.0;
   Backend backend = Backend::kAuto;

@@ -13,7 +13,7 @@ namespace featsense::tsdf {
 
 struct TsdfSettings {
   float voxel_size_m = 0.064f;
-  float truncation_m = 0.6f;
+  float truncation_m = 0.25f;
   float max_weight = 10.0f;
   std::array<float, 3> map_size_m = {40.0f, 40.0f, 15.0f};
   /// tan of the vertical angle between two beams (vfov / beams, paper eq. 7); 0 = no
@@ -23,6 +23,13 @@ struct TsdfSettings {
   /// the local map; end points outside it are all kept. Rays to one voxel propose nearly
   /// the same values, so this saves work at a loss below the voxel size.
   bool reduce_points_per_voxel = true;
+  /// Sparse carving: within this distance of the sensor neighbouring rays are less than a
+  /// quarter voxel apart, and every voxel would be carved by many of them. There only a
+  /// lattice of rays carves free space: a ray of carving level L (RayBatch::carving_level,
+  /// its beam and column multiples of 2^L) from dense_range_m / 2^L outwards, so the rays
+  /// that carve at any distance are at most half a voxel apart. The truncation band is
+  /// always walked by every ray. 0: every ray carves all the way to the sensor.
+  float dense_range_m = 0.0f;
 
   /// Voxels per axis: the size rounded up to whole bricks and to an odd count of bricks, so
   /// that the sensor sits in the centre brick.
@@ -32,7 +39,8 @@ struct TsdfSettings {
   /// Where the weight of a scan starts to fall off behind the surface, fixed point (one voxel).
   int32_t falloff_start_fixed() const;
 
-  /// Settings of config.map, interpolation from the sensor's vertical field of view and beams.
+  /// Settings of config.map, interpolation from the sensor's vertical field of view and beams,
+  /// the dense range from its coarsest angle between neighbouring beams or columns.
   static TsdfSettings from_config(const config::MapConfig& map, const config::SensorModel& sensor);
 };
 
