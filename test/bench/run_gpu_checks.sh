@@ -45,7 +45,8 @@ if [ "$what" = bench ] || [ "$what" = all ]; then
       summary "$out/bench_store_${backend}.json" "store shift 10 m" slab_mb sync_s checkpoint_s file_mb
   done
   # What the defaults of the truncation and the sparse carving each change, on the CUDA backend.
-  for variant in "old map.truncation=0.6 map.sparse_carving=false" "full map.sparse_carving=false"; do
+  for variant in "old map.truncation=0.6 map.sparse_carving=false" "full map.sparse_carving=false" \
+                 "band map.carve_free_space=false"; do
     set -- $variant; name=$1; shift
     sets=(); for kv in "$@"; do sets+=(--set "$kv"); done
     for scene in indoor outdoor; do
@@ -64,11 +65,14 @@ if [ "$what" = map ] || [ "$what" = all ]; then
   "$bin/featsense" simulate --quiet --scene parking --path drive -o "$sim" 2>&1 | tail -1
   frames=$(ls "$sim"/frame_*.pcd | wc -l)
   echo "parking drive: $frames frames"
-  report() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); t=r['timings']; e=r.get('eval',{}).get('mesh',{}); print(sys.argv[2], r['frames'], 'frames', '%.1f scans/s' % r['scans_per_s'], 'rtf %.2f' % r['real_time_factor'], 'integrate median %.2f ms p95 %.2f' % (t['integrate']['median_ms'], t['integrate']['p95_ms']), 'shift max %.0f ms' % t['shift']['max_ms'], 'final flush %.1f s' % t['final_flush']['max_ms'] if t['final_flush']['count'] else '', 'rss %.0f MB' % r['peak_rss_mb'], 'mesh', r.get('mesh'), 'accuracy', e.get('accuracy',{}).get('mean_abs'), 'completeness', e.get('completeness'))" "$@"; }
+  report() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); t=r['timings']; e=r.get('eval',{}).get('mesh',{}); print(sys.argv[2], r['frames'], 'frames', '%.1f scans/s' % r['scans_per_s'], 'rtf %.2f' % r['real_time_factor'], 'integrate median %.2f ms p95 %.2f' % (t['integrate']['median_ms'], t['integrate']['p95_ms']), 'shift max %.0f ms' % t['shift']['max_ms'], 'final flush %.1f s' % (t['final_flush']['max_ms'] / 1000) if t['final_flush']['count'] else '', 'rss %.0f MB' % r['peak_rss_mb'], 'mesh', r.get('mesh'), 'accuracy', e.get('accuracy',{}).get('mean_abs'), 'completeness', e.get('completeness'))" "$@"; }
   "$bin/featsense" map "$sim" -o "$out/map_parking_cuda" --gt "$sim/gt_trajectory.tum" --backend cuda --quiet
   report "$out/map_parking_cuda/report.json" "map parking cuda"
   $two_cores "$bin/featsense" map "$sim" -o "$out/map_parking_cpu" --gt "$sim/gt_trajectory.tum" --backend cpu --quiet --end 80 --no-mesh
   report "$out/map_parking_cpu/report.json" "map parking cpu 2 cores (80 frames)"
+  $two_cores "$bin/featsense" map "$sim" -o "$out/map_parking_cpu_band" --gt "$sim/gt_trajectory.tum" --backend cpu --quiet \
+    --set map.carve_free_space=false
+  report "$out/map_parking_cpu_band/report.json" "map parking cpu 2 cores, band only (no free-space carving)"
   "$bin/featsense" map /tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3.pcap --meta /tmp/bundle/OS-1-128_v2.3.0_1024x10.json \
     --gt /tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt -o "$out/map_os1" --backend cuda --quiet
   report "$out/map_os1/report.json" "map os1 real"

@@ -49,8 +49,8 @@ class BruteForceIntegrator {
       ++stats.rays;
       detail::RayMarchParams ray_params = params;
       if (!rays.may_interpolate(i)) ray_params.interpolation_slope = 0.0f;
-      ray_params.carve_from_m =
-          detail::carving_start(settings_.dense_range_m, rays.carving_level_of(i));
+      ray_params.carve_from_m = detail::carving_start(
+          settings_.carve_free_space, settings_.dense_range_m, rays.carving_level_of(i));
       detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray_params,
                         [&](size_t index, int32_t value, bool interpolated) {
                           if (candidates_[index] == kEmptyCandidate) touched.push_back(index);
@@ -177,6 +177,8 @@ TEST(CpuIntegratorExact, SparseCarving) {
   expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
   s.dense_range_m *= 4.0f;  // most of the room within the dense range
   s.reduce_points_per_voxel = false;
+  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+  s.carve_free_space = false;  // the band only
   expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
 }
 

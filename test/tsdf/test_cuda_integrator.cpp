@@ -96,6 +96,8 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceOnAMovingSensor) {
   // Sparse carving: each ray's walk ends where its carving level says, on both backends.
   s.dense_range_m = 4.0f * 2.6f;  // most of the room: many walks end early
   expect_same_map(s, test::box_room_rays(4, false, true), "box room, small map, sparse carving");
+  s.carve_free_space = false;
+  expect_same_map(s, test::box_room_rays(4, false, true), "box room, small map, band only");
 }
 
 TEST(CudaIntegrator, ReportsItsDeviceMemory) {

@@ -1,5 +1,6 @@
-// Sparse carving (TsdfSettings::dense_range_m) against full carving on the same scan: it may
-// only leave out free-space voxels near the sensor, and only few of them.
+// Sparse carving (TsdfSettings::dense_range_m) and no carving (carve_free_space) against full
+// carving on the same scan: they may only leave out free-space voxels; sparse carving only few
+// of them, near the sensor.
 
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@ namespace {
 struct Comparison {
   size_t full_observed = 0;   ///< voxels full carving updated
   size_t band_differing = 0;  ///< voxels not at +tau under full carving that differ
+  size_t free_differing = 0;  ///< voxels at +tau under full carving, other values here
   size_t extra = 0;           ///< voxels only sparse carving updated
   size_t missed = 0;          ///< free voxels only full carving updated
   float farthest_missed_m = 0.0f;
@@ -37,6 +39,7 @@ void for_each_voxel(const LocalMapGeometry& g, const Visit& visit) {
 Comparison compare_one_scan(TsdfSettings settings, const RayBatch& scan, Vec3 sensor) {
   TsdfSettings full_settings = settings;
   full_settings.dense_range_m = 0.0f;
+  full_settings.carve_free_space = true;
   auto full = make_cpu_integrator(full_settings, sensor);
   auto sparse = make_cpu_integrator(settings, sensor);
   full->integrate(scan);
@@ -57,7 +60,7 @@ Comparison compare_one_scan(TsdfSettings settings, const RayBatch& scan, Vec3 se
       ++c.missed;
       c.farthest_missed_m = std::max(c.farthest_missed_m, distance(centre, sensor));
     } else {
-      c.band_differing += a[i] != b[i] ? 1 : 0;  // free in both: must be the same
+      c.free_differing += a[i] != b[i] ? 1 : 0;
     }
   });
   std::printf(
@@ -80,6 +83,7 @@ TEST(SparseCarving, LeavesOutOnlyFewFreeVoxelsNearTheSensor) {
   const RayBatch scan = test::box_room_rays(1, false, true).front();
   const Comparison c = compare_one_scan(s, scan, scan.origins_m.front());
   EXPECT_EQ(c.band_differing, 0u) << "surfaces and the band must not change";
+  EXPECT_EQ(c.free_differing, 0u);
   EXPECT_EQ(c.extra, 0u);
   EXPECT_GT(c.full_observed, 1000000u);
   EXPECT_LT(static_cast<double>(c.missed), 0.002 * static_cast<double>(c.full_observed));
@@ -91,7 +95,22 @@ TEST(SparseCarving, WithoutLevelsEveryRayCarvesAllTheWay) {
   const TsdfSettings s = os1_settings();
   const RayBatch scan = test::box_room_rays(1, false, false).front();
   const Comparison c = compare_one_scan(s, scan, scan.origins_m.front());
-  EXPECT_EQ(c.band_differing + c.extra + c.missed, 0u);
+  EXPECT_EQ(c.band_differing + c.free_differing + c.extra + c.missed, 0u);
+}
+
+TEST(FreeSpaceCarving, OffKeepsTheBandAndLeavesFreeSpaceAlone) {
+  TsdfSettings s = os1_settings();
+  s.carve_free_space = false;
+  const RayBatch scan = test::box_room_rays(1, false, true).front();
+  const Comparison c = compare_one_scan(s, scan, scan.origins_m.front());
+  EXPECT_EQ(c.band_differing, 0u) << "surfaces and the band must not change";
+  EXPECT_EQ(c.extra, 0u);
+  EXPECT_GT(static_cast<double>(c.missed), 0.7 * static_cast<double>(c.full_observed));
+  // Cells that only vertical interpolation filled keep their value where, with carving, a
+  // ray passing through them in free space would have overruled it (a measurement beats an
+  // interpolation): a few.
+  EXPECT_GT(c.free_differing, 0u);
+  EXPECT_LT(static_cast<double>(c.free_differing), 0.01 * static_cast<double>(c.full_observed));
 }
 
 TEST(SparseCarving, RaysOfLevelZeroStopCarvingAtTheDenseRange) {

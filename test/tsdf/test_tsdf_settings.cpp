@@ -35,6 +35,9 @@ TEST(TsdfSettings, SparseCarvingRangeFollowsTheCoarsestAngleBetweenRays) {
   EXPECT_NEAR(TsdfSettings::from_config(map, os1).dense_range_m, 2.0f * s.dense_range_m, 1e-3);
   map.sparse_carving = false;
   EXPECT_EQ(TsdfSettings::from_config(map, os1).dense_range_m, 0.0f);
+  EXPECT_TRUE(TsdfSettings::from_config(map, os1).carve_free_space);
+  map.carve_free_space = false;
+  EXPECT_FALSE(TsdfSettings::from_config(map, os1).carve_free_space);
 }
 
 TEST(TsdfSettings, SizesAndWeightsComeFromTheMapConfig) {

@@ -74,7 +74,7 @@ struct ProposeCandidate {
 
 __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
                                 const uint8_t* interpolate, const uint8_t* carving_level,
-                                float dense_range_m, const uint32_t* kept,
+                                bool carve_free_space, float dense_range_m, const uint32_t* kept,
                                 const uint32_t* kept_count, detail::RayMarchParams params,
                                 ProposeCandidate propose) {
   const uint32_t count = *kept_count;
@@ -84,8 +84,9 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
     const uint32_t i = kept[k];
     const bool may_interpolate = interpolate == nullptr || interpolate[i] != 0;
     detail::RayMarchParams ray = may_interpolate ? params : flat;
-    ray.carve_from_m = detail::carving_start(
-        dense_range_m, carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
+    ray.carve_from_m =
+        detail::carving_start(carve_free_space, dense_range_m,
+                              carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
     detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose);
   }
 }
@@ -242,7 +243,8 @@ class CudaIntegrator final : public Integrator {
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
         origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
-        settings_.dense_range_m, kept_.data(), kept_count, params, propose);
+        settings_.carve_free_space, settings_.dense_range_m, kept_.data(), kept_count, params,
+        propose);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),

@@ -307,7 +307,8 @@ class CpuIntegrator final : public Integrator {
     flat.interpolation_slope = 0.0f;
     for (const uint32_t i : ray_ids) {
       detail::RayMarchParams ray = rays.may_interpolate(i) ? params : flat;
-      ray.carve_from_m = detail::carving_start(settings_.dense_range_m, rays.carving_level_of(i));
+      ray.carve_from_m = detail::carving_start(settings_.carve_free_space, settings_.dense_range_m,
+                                               rays.carving_level_of(i));
       detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, propose);
     }
   }

@@ -26,8 +26,11 @@ struct RayMarchParams {
 
 /// Where a ray of carving level `level` starts to carve free space: dense_range / 2^level, so
 /// that at any distance the rays that carve there are at most half a voxel apart (0: all the
-/// way). A division by a power of two: exact, the same on host and device.
-FEATSENSE_HD_INLINE float carving_start(float dense_range_m, uint32_t level) {
+/// way); nowhere without free-space carving. A division by a power of two: exact, the same on
+/// host and device.
+FEATSENSE_HD_INLINE float carving_start(bool carve_free_space, float dense_range_m,
+                                        uint32_t level) {
+  if (!carve_free_space) return FLT_MAX;
   if (!(dense_range_m > 0.0f) || level >= kFullCarvingLevel) return 0.0f;
   return dense_range_m / static_cast<float>(1u << level);
 }

@@ -60,6 +60,7 @@ TsdfSettings TsdfSettings::from_config(const config::MapConfig& map,
         static_cast<float>(std::tan(sensor.vertical_fov_rad() / static_cast<double>(sensor.beams)));
   }
   if (map.sparse_carving) s.dense_range_m = dense_range(s.voxel_size_m, sensor);
+  s.carve_free_space = map.carve_free_space;
   return s;
 }
 

@@ -32,6 +32,8 @@ struct MapConfig {
   /// Near the sensor, where rays are much denser than voxels, only a lattice of them carves
   /// free space (TsdfSettings::dense_range_m).
   bool sparse_carving = true;
+  /// Rays carve the free space in front of their surfaces (false: the band only).
+  bool carve_free_space = true;
   /// Seconds between two writes of the local map into the store during a run.
   double flush_interval_s = 30.0;
   Backend backend = Backend::kAuto;

@@ -30,6 +30,10 @@ struct TsdfSettings {
   /// that carve at any distance are at most half a voxel apart. The truncation band is
   /// always walked by every ray. 0: every ray carves all the way to the sensor.
   float dense_range_m = 0.0f;
+  /// false: rays walk only the truncation band around their end points (and two voxels in
+  /// front of it), free space is not carved. Several times faster, but what moves through
+  /// the scene leaves its surfaces in the map.
+  bool carve_free_space = true;
 
   /// Voxels per axis: the size rounded up to whole bricks and to an odd count of bricks, so
   /// that the sensor sits in the centre brick.
