@@ -58,6 +58,14 @@ if [ "$what" = bench ] || [ "$what" = all ]; then
       --json "$out/bench_tsdf_cuda_os1_$name.json" > /dev/null &&
       summary "$out/bench_tsdf_cuda_os1_$name.json" "tsdf os1-real ($*)"
   done
+  for scene in indoor outdoor; do
+    $two_cores "$bin/featsense" bench tsdf --quiet --backend cpu --scene "$scene" --repeat 10 \
+      --set map.carve_free_space=false --json "$out/bench_tsdf_cpu_${scene}_band.json" > /dev/null &&
+      summary "$out/bench_tsdf_cpu_${scene}_band.json" "tsdf $scene (band only)"
+  done
+  $two_cores "$bin/featsense" bench tsdf --quiet --backend cpu --repeat 10 --input "$pcap" --meta "$meta" \
+    --set map.carve_free_space=false --json "$out/bench_tsdf_cpu_os1_band.json" > /dev/null &&
+    summary "$out/bench_tsdf_cpu_os1_band.json" "tsdf os1-real (band only)"
 fi
 
 if [ "$what" = map ] || [ "$what" = all ]; then

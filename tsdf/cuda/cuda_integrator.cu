@@ -1,6 +1,7 @@
 // The CUDA integrator: the same rule as the CPU reference (voxel.hpp, ray_marcher.hpp) in
-// four kernels per scan: keep one end point per voxel, the per-scan minimum (atomicMin on
-// the ordered candidate keys), fusion of the touched voxels, and their reset.
+// five kernels per scan: keep one end point per voxel (two), the per-scan minimum (atomicMin
+// on the ordered candidate keys), the list of touched bricks, and the fusion of their voxels
+// with the reset of the candidates.
 
 #include <cuda_runtime.h>
 
@@ -56,21 +57,34 @@ struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;
   uint32_t* brick_flags;
-  uint32_t* touched_bricks;
-  uint32_t* touched_brick_count;
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
     const uint32_t key = make_candidate(value, interpolated);
     // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
-    if (candidates[index] <= key) return;
-    if (atomicMin(&candidates[index], key) != kEmptyCandidate) return;
-    // The first candidate of a voxel: list its brick once, for the fusion.
-    const uint32_t brick = static_cast<uint32_t>(index / kBrickVoxels);
-    if (brick_flags[brick] == 0u && atomicExch(&brick_flags[brick], 1u) == 0u) {
-      touched_bricks[atomicAdd(touched_brick_count, 1u)] = brick;
-    }
+    const uint32_t current = candidates[index];
+    if (current <= key) return;
+    // The old value is not needed, so the minimum is a reduction the thread does not wait for.
+    atomicMin(&candidates[index], key);
+    // Mark the brick for the fusion. The thread whose minimum lands first on an empty voxel
+    // read it empty (nothing had landed before), so every touched brick gets marked.
+    if (current == kEmptyCandidate) brick_flags[index / kBrickVoxels] = 1u;
   }
 };
+
+/// The marked bricks, listed for the fusion (in no particular order; one atomic per warp).
+__global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, uint32_t brick_count,
+                                           uint32_t* touched_bricks, uint32_t* touched_count) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const bool touched = i < brick_count && brick_flags[i] != 0u;
+  const unsigned int lanes = __ballot_sync(0xffffffffu, touched);
+  if (lanes == 0u) return;
+  const int lane = static_cast<int>(threadIdx.x % 32u);
+  const int leader = __ffs(static_cast<int>(lanes)) - 1;
+  uint32_t first = 0;
+  if (lane == leader) first = atomicAdd(touched_count, static_cast<uint32_t>(__popc(lanes)));
+  first = __shfl_sync(0xffffffffu, first, leader);
+  if (touched) touched_bricks[first + __popc(lanes & ((1u << lane) - 1u))] = i;
+}
 
 __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
                                 const uint8_t* interpolate, const uint8_t* carving_level,
@@ -237,14 +251,17 @@ class CudaIntegrator final : public Integrator {
     params.truncation_m = settings_.truncation_m;
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
-    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
-                                   touched_bricks_.data(), touched_count};
+    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data()};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
         origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
         settings_.carve_free_space, settings_.dense_range_m, kept_.data(), kept_count, params,
         propose);
+    FEATSENSE_CUDA_CHECK(cudaGetLastError());
+    const auto brick_count = static_cast<uint32_t>(geometry_.voxel_count() / kBrickVoxels);
+    list_touched_bricks_kernel<<<blocks_for(brick_count), kThreads, 0, stream_>>>(
+        brick_flags_.data(), brick_count, touched_bricks_.data(), touched_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
