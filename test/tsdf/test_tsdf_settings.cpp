@@ -24,13 +24,13 @@ TEST(TsdfSettings, InterpolationFollowsTheSensorsBeamSpacingOrIsOff) {
 TEST(TsdfSettings, SparseCarvingRangeFollowsTheCoarsestAngleBetweenRays) {
   config::MapConfig map;
   const config::SensorModel os1 = config::sensor_preset("os1-128");
-  // Columns 2 pi / 1024 = 6.14 mrad apart, beams about the same: 6.4 cm / (4 x 6.1 mrad).
+  // Columns 2 pi / 1024 = 6.14 mrad apart, beams about the same: 6.4 cm / (2 x 6.1 mrad).
   const TsdfSettings s = TsdfSettings::from_config(map, os1);
-  EXPECT_GT(s.dense_range_m, 2.3f);
-  EXPECT_LT(s.dense_range_m, 0.064f / (4.0f * 2.0f * 3.14159265f / 1024.0f) + 1e-4f);
-  // 16 beams 2 deg apart: the beams, not the columns, set it: 6.4 cm / (4 x 34.9 mrad).
+  EXPECT_GT(s.dense_range_m, 4.6f);
+  EXPECT_LT(s.dense_range_m, 0.064f / (2.0f * 2.0f * 3.14159265f / 1024.0f) + 1e-4f);
+  // 16 beams 2 deg apart: the beams, not the columns, set it: 6.4 cm / (2 x 34.9 mrad).
   const TsdfSettings vlp = TsdfSettings::from_config(map, config::sensor_preset("vlp16"));
-  EXPECT_NEAR(vlp.dense_range_m, 0.064 / (4.0 * 2.0 * 3.14159265 / 180.0), 0.01);
+  EXPECT_NEAR(vlp.dense_range_m, 0.064 / (2.0 * 2.0 * 3.14159265 / 180.0), 0.01);
   map.voxel_size_m = 0.128;
   EXPECT_NEAR(TsdfSettings::from_config(map, os1).dense_range_m, 2.0f * s.dense_range_m, 1e-3);
   map.sparse_carving = false;

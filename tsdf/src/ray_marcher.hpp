@@ -25,7 +25,7 @@ struct RayMarchParams {
 };
 
 /// Where a ray of carving level `level` starts to carve free space: dense_range / 2^level, so
-/// that at any distance the rays that carve there are at most half a voxel apart (0: all the
+/// that at any distance the rays that carve there are at most a voxel apart (0: all the
 /// way); nowhere without free-space carving. A division by a power of two: exact, the same on
 /// host and device.
 FEATSENSE_HD_INLINE float carving_start(bool carve_free_space, float dense_range_m,

@@ -9,8 +9,8 @@
 namespace featsense::tsdf {
 namespace {
 
-/// voxel / (4 x the coarsest angle between neighbouring rays): nearer than that, rays of
-/// every second beam and column are still at most half a voxel apart (TsdfSettings).
+/// voxel / (2 x the coarsest angle between neighbouring rays): nearer than that, rays of
+/// every second beam and column are still at most a voxel apart (TsdfSettings).
 /// 0 for a model without beams or columns.
 float dense_range(float voxel_size_m, const config::SensorModel& sensor) {
   if (sensor.beams < 2 || sensor.columns < 1) return 0.0f;
@@ -24,7 +24,7 @@ float dense_range(float voxel_size_m, const config::SensorModel& sensor) {
     widest = std::max(widest, sensor.vertical_fov_rad() / static_cast<double>(sensor.beams - 1));
   }
   if (!(widest > 0.0)) return 0.0f;
-  return static_cast<float>(static_cast<double>(voxel_size_m) / (4.0 * widest));
+  return static_cast<float>(static_cast<double>(voxel_size_m) / (2.0 * widest));
 }
 
 }  // namespace

@@ -23,11 +23,12 @@ struct TsdfSettings {
   /// the local map; end points outside it are all kept. Rays to one voxel propose nearly
   /// the same values, so this saves work at a loss below the voxel size.
   bool reduce_points_per_voxel = true;
-  /// Sparse carving: within this distance of the sensor neighbouring rays are less than a
-  /// quarter voxel apart, and every voxel would be carved by many of them. There only a
+  /// Sparse carving: within this distance of the sensor neighbouring rays are less than half
+  /// a voxel apart, and every voxel would be carved by several of them. There only a
   /// lattice of rays carves free space: a ray of carving level L (RayBatch::carving_level,
   /// its beam and column multiples of 2^L) from dense_range_m / 2^L outwards, so the rays
-  /// that carve at any distance are at most half a voxel apart. The truncation band is
+  /// that carve at any distance are at most a voxel apart, as all rays are at twice this
+  /// distance. The truncation band is
   /// always walked by every ray. 0: every ray carves all the way to the sensor.
   float dense_range_m = 0.0f;
   /// false: rays walk only the truncation band around their end points (and two voxels in
