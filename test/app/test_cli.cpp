@@ -105,5 +105,25 @@ TEST(Cli, ConvertedFramesReadBackAsTheSameRecording) {
   EXPECT_EQ(a["first_stamp_ns"], b["first_stamp_ns"]);
 }
 
+TEST(CliBenchTsdf, IntegratesTheSequenceOncePerPassIntoANewMap) {
+  const std::filesystem::path dir = scratch_dir("cli_bench_tsdf");
+  const std::filesystem::path json = dir / "bench.json";
+  const CommandResult result =
+      run_featsense("bench tsdf --backend cpu --map 12x12x6 --scans 3 --passes 2 --quiet --json " +
+                    json.string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json figures = read_json(json);
+  EXPECT_EQ(figures["backend"], "cpu");
+  EXPECT_EQ(figures["passes"].get<int>(), 2);
+  EXPECT_EQ(figures["sequence_scans"].get<int>(), 3);
+  // The first scan of each pass meets an empty map and is reported on its own.
+  EXPECT_EQ(figures["timed_scans"].get<int>(), 4);
+  EXPECT_GT(figures["empty_map_ms"].get<double>(), 0.0);
+  EXPECT_GT(figures["median_ms"].get<double>(), 0.0);
+  EXPECT_LE(figures["median_ms"].get<double>(), figures["max_ms"].get<double>());
+  EXPECT_GT(figures["voxels_updated_per_scan"]["median"].get<double>(), 10000.0);
+  EXPECT_EQ(figures["map_voxels"][0].get<int>(), 200);  // 12 m / 6.4 cm, odd bricks
+}
+
 }  // namespace
 }  // namespace featsense::test

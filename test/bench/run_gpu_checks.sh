@@ -29,43 +29,33 @@ fi
 if [ "$what" = bench ] || [ "$what" = all ]; then
   pcap=/tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3.pcap
   meta=/tmp/bundle/OS-1-128_v2.3.0_1024x10.json
-  for backend in cuda cpu; do
-    run=""; repeat=200
-    if [ "$backend" = cpu ]; then run=$two_cores; repeat=10; fi
+  # Built-in scenes: 50 scans of a moving sensor, each pass into a new map (cuda 4 passes,
+  # cpu 1); the real recording's 3 frames at the origin, each pass into a new map.
+  # Variants: the default; "nosettle" (w_max 500, so no free space settles within the run:
+  # the work of every carving ray, as before settled free space was passed by); band only.
+  bench() {  # backend name extra-args...
+    local backend=$1 name=$2; shift 2
+    local run="" passes=4 real_passes=20
+    if [ "$backend" = cpu ]; then run=$two_cores; passes=1; real_passes=3; fi
     for scene in indoor outdoor; do
-      $run "$bin/featsense" bench tsdf --quiet --backend "$backend" --scene "$scene" --repeat "$repeat" \
-        --json "$out/bench_tsdf_${backend}_${scene}.json" > /dev/null &&
-        summary "$out/bench_tsdf_${backend}_${scene}.json" "tsdf $scene" points_per_s memory_bytes
+      $run "$bin/featsense" bench tsdf --quiet --backend "$backend" --scene "$scene" --passes "$passes" "$@" \
+        --json "$out/bench_tsdf_${backend}_${scene}_$name.json" > /dev/null &&
+        summary "$out/bench_tsdf_${backend}_${scene}_$name.json" "tsdf $scene $name" empty_map_ms voxels_updated_per_scan
     done
-    $run "$bin/featsense" bench tsdf --quiet --backend "$backend" --repeat "$repeat" --input "$pcap" --meta "$meta" \
-      --json "$out/bench_tsdf_${backend}_os1.json" > /dev/null &&
-      summary "$out/bench_tsdf_${backend}_os1.json" "tsdf os1-real" points_per_s
+    $run "$bin/featsense" bench tsdf --quiet --backend "$backend" --passes "$real_passes" --input "$pcap" --meta "$meta" "$@" \
+      --json "$out/bench_tsdf_${backend}_os1_$name.json" > /dev/null &&
+      summary "$out/bench_tsdf_${backend}_os1_$name.json" "tsdf os1-real $name" voxels_updated_per_scan
+  }
+  for backend in cuda cpu; do
+    run=""; [ "$backend" = cpu ] && run=$two_cores
+    bench "$backend" default
+    bench "$backend" nosettle --set map.max_weight=500
+    bench "$backend" band --set map.carve_free_space=false
     $run "$bin/featsense" bench store --quiet --backend "$backend" --dir /tmp/store \
       --json "$out/bench_store_${backend}.json" > /dev/null &&
       summary "$out/bench_store_${backend}.json" "store shift 10 m" slab_mb sync_s checkpoint_s file_mb
   done
-  # What the defaults of the truncation and the sparse carving each change, on the CUDA backend.
-  for variant in "old map.truncation=0.6 map.sparse_carving=false" "full map.sparse_carving=false" \
-                 "band map.carve_free_space=false"; do
-    set -- $variant; name=$1; shift
-    sets=(); for kv in "$@"; do sets+=(--set "$kv"); done
-    for scene in indoor outdoor; do
-      "$bin/featsense" bench tsdf --quiet --backend cuda --scene "$scene" --repeat 200 "${sets[@]}" \
-        --json "$out/bench_tsdf_cuda_${scene}_$name.json" > /dev/null &&
-        summary "$out/bench_tsdf_cuda_${scene}_$name.json" "tsdf $scene ($*)"
-    done
-    "$bin/featsense" bench tsdf --quiet --backend cuda --repeat 200 --input "$pcap" --meta "$meta" "${sets[@]}" \
-      --json "$out/bench_tsdf_cuda_os1_$name.json" > /dev/null &&
-      summary "$out/bench_tsdf_cuda_os1_$name.json" "tsdf os1-real ($*)"
-  done
-  for scene in indoor outdoor; do
-    $two_cores "$bin/featsense" bench tsdf --quiet --backend cpu --scene "$scene" --repeat 10 \
-      --set map.carve_free_space=false --json "$out/bench_tsdf_cpu_${scene}_band.json" > /dev/null &&
-      summary "$out/bench_tsdf_cpu_${scene}_band.json" "tsdf $scene (band only)"
-  done
-  $two_cores "$bin/featsense" bench tsdf --quiet --backend cpu --repeat 10 --input "$pcap" --meta "$meta" \
-    --set map.carve_free_space=false --json "$out/bench_tsdf_cpu_os1_band.json" > /dev/null &&
-    summary "$out/bench_tsdf_cpu_os1_band.json" "tsdf os1-real (band only)"
+  echo "points/s and memory:"; summary "$out/bench_tsdf_cuda_indoor_default.json" "cuda indoor" points_per_s memory_bytes
 fi
 
 if [ "$what" = map ] || [ "$what" = all ]; then
@@ -76,8 +66,8 @@ if [ "$what" = map ] || [ "$what" = all ]; then
   report() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); t=r['timings']; e=r.get('eval',{}).get('mesh',{}); print(sys.argv[2], r['frames'], 'frames', '%.1f scans/s' % r['scans_per_s'], 'rtf %.2f' % r['real_time_factor'], 'integrate median %.2f ms p95 %.2f' % (t['integrate']['median_ms'], t['integrate']['p95_ms']), 'shift max %.0f ms' % t['shift']['max_ms'], 'final flush %.1f s' % (t['final_flush']['max_ms'] / 1000) if t['final_flush']['count'] else '', 'rss %.0f MB' % r['peak_rss_mb'], 'mesh', r.get('mesh'), 'accuracy', e.get('accuracy',{}).get('mean_abs'), 'completeness', e.get('completeness'))" "$@"; }
   "$bin/featsense" map "$sim" -o "$out/map_parking_cuda" --gt "$sim/gt_trajectory.tum" --backend cuda --quiet
   report "$out/map_parking_cuda/report.json" "map parking cuda"
-  $two_cores "$bin/featsense" map "$sim" -o "$out/map_parking_cpu" --gt "$sim/gt_trajectory.tum" --backend cpu --quiet --end 80 --no-mesh
-  report "$out/map_parking_cpu/report.json" "map parking cpu 2 cores (80 frames)"
+  $two_cores "$bin/featsense" map "$sim" -o "$out/map_parking_cpu" --gt "$sim/gt_trajectory.tum" --backend cpu --quiet
+  report "$out/map_parking_cpu/report.json" "map parking cpu 2 cores"
   $two_cores "$bin/featsense" map "$sim" -o "$out/map_parking_cpu_band" --gt "$sim/gt_trajectory.tum" --backend cpu --quiet \
     --set map.carve_free_space=false
   report "$out/map_parking_cpu_band/report.json" "map parking cpu 2 cores, band only (no free-space carving)"

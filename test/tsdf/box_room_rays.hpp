@@ -53,4 +53,13 @@ inline std::vector<RayBatch> box_room_rays(int frames, bool outdoor, bool carvin
   return batches;
 }
 
+/// The `frames` scans of box_room_rays, `passes` times over: a sensor that keeps seeing the
+/// same free space (with a weight cap of 2, free space seen twice is settled).
+inline std::vector<RayBatch> box_room_passes(int frames, int passes) {
+  const std::vector<RayBatch> room = box_room_rays(frames, false);
+  std::vector<RayBatch> scans;
+  for (int pass = 0; pass < passes; ++pass) scans.insert(scans.end(), room.begin(), room.end());
+  return scans;
+}
+
 }  // namespace featsense::tsdf::test

@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "featsense/tsdf/integrator.hpp"
 #include "featsense/tsdf/voxel.hpp"
@@ -26,6 +27,20 @@ struct ObservedVoxel {
   float distance_m;  ///< the stored value in metres
   float weight;      ///< the stored weight (1.0 = one full measurement)
 };
+
+/// Every brick of the local map, by global brick coordinate (for read_bricks / write_bricks).
+inline std::vector<Index3> all_bricks(const LocalMapGeometry& g) {
+  std::vector<Index3> bricks;
+  for (int32_t z = 0; z < g.dim.z; z += kBrickSize) {
+    for (int32_t y = 0; y < g.dim.y; y += kBrickSize) {
+      for (int32_t x = 0; x < g.dim.x; x += kBrickSize) {
+        bricks.push_back({(g.origin.x + x) / kBrickSize, (g.origin.y + y) / kBrickSize,
+                          (g.origin.z + z) / kBrickSize});
+      }
+    }
+  }
+  return bricks;
+}
 
 /// Calls f for every voxel of the map (observed or not).
 inline void for_each_voxel(const Integrator& integrator, float truncation_m,

@@ -1,7 +1,8 @@
 // The CUDA integrator: the same rule as the CPU reference (voxel.hpp, ray_marcher.hpp) in
 // five kernels per scan: keep one end point per voxel (two), the per-scan minimum (atomicMin
 // on the ordered candidate keys), the list of touched bricks, and the fusion of their voxels
-// with the reset of the candidates.
+// with the reset of the candidates. Free-space candidates pass settled free space by
+// (voxel.hpp, settled_free_voxel), found in a bit per voxel that the fusion keeps.
 
 #include <cuda_runtime.h>
 
@@ -53,12 +54,27 @@ __global__ void select_rays_kernel(const Vec3* endpoints, uint32_t n, LocalMapGe
   if (keep) kept[atomicAdd(kept_count, 1u)] = i;
 }
 
+/// The bit of a voxel in a bit set of 32-bit words: a warp's 32 consecutive voxels are a word.
+__device__ bool bit_of(const uint32_t* bits, size_t index) {
+  return ((bits[index / 32] >> (index % 32)) & 1u) != 0u;
+}
+
+/// Sets each lane's voxel bit in the warp's word. The whole warp calls it, on 32 consecutive
+/// voxels starting at a multiple of 32.
+__device__ void write_warp_bits(uint32_t* bits, size_t index, bool bit) {
+  const unsigned int word = __ballot_sync(0xffffffffu, bit);
+  if (threadIdx.x % 32u == 0u) bits[index / 32] = word;
+}
+
 struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;
   uint32_t* brick_flags;
+  const uint32_t* settled;
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
+    // Settled free space stays as it is (its bits are mostly in the L1 cache).
+    if (value == kValueScale && bit_of(settled, index)) return;
     const uint32_t key = make_candidate(value, interpolated);
     // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
     const uint32_t current = candidates[index];
@@ -90,7 +106,7 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
                                 const uint8_t* interpolate, const uint8_t* carving_level,
                                 bool carve_free_space, float dense_range_m, const uint32_t* kept,
                                 const uint32_t* kept_count, detail::RayMarchParams params,
-                                ProposeCandidate propose) {
+                                ProposeCandidate propose, const uint8_t* settled_bricks) {
   const uint32_t count = *kept_count;
   detail::RayMarchParams flat = params;
   flat.interpolation_slope = 0.0f;
@@ -101,30 +117,40 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
     ray.carve_from_m =
         detail::carving_start(carve_free_space, dense_range_m,
                               carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
-    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose);
+    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose,
+                      settled_bricks);
   }
 }
 
 /// One block per touched brick, one thread per voxel: the brick's 2 KB are read and written
-/// in whole cache lines. Also resets the candidates and the brick's flag for the next scan.
+/// in whole cache lines. Also resets the candidates and the brick's flag for the next scan,
+/// and renews the brick's settled bits.
 __global__ void fuse_bricks_kernel(const uint32_t* touched_bricks, const uint32_t* touched_count,
                                    uint32_t* brick_flags, uint32_t* candidates, uint32_t* map,
-                                   int32_t falloff, uint32_t max_weight, uint32_t* voxels_updated) {
+                                   uint32_t* settled, uint8_t* settled_bricks, int32_t falloff,
+                                   uint32_t max_weight, uint32_t* voxels_updated) {
   const uint32_t count = *touched_count;
+  const uint32_t settled_voxel = settled_free_voxel(max_weight);
   for (uint32_t k = blockIdx.x; k < count; k += gridDim.x) {
     const uint32_t brick = touched_bricks[k];
     const size_t index = static_cast<size_t>(brick) * kBrickVoxels + threadIdx.x;
     const uint32_t key = candidates[index];
     const bool updated = key != kEmptyCandidate;
+    bool is_settled = bit_of(settled, index);
     if (updated) {
       candidates[index] = kEmptyCandidate;
       const int32_t value = candidate_value(key);
-      map[index] =
+      const uint32_t fused =
           pack(fuse(unpack(map[index]), value, candidate_weight(value, falloff), max_weight));
+      map[index] = fused;
+      is_settled = fused == settled_voxel;
     }
+    write_warp_bits(settled, index, is_settled);
+    const int all_settled = __syncthreads_and(is_settled);
     const int block_updated = __syncthreads_count(updated);
     if (threadIdx.x == 0) {
       brick_flags[brick] = 0u;
+      settled_bricks[brick] = all_settled != 0 ? 1u : 0u;
       atomicAdd(voxels_updated, static_cast<uint32_t>(block_updated));
     }
   }
@@ -139,9 +165,14 @@ __global__ void gather_bricks_kernel(const uint32_t* map, const uint64_t* offset
 }
 
 __global__ void scatter_bricks_kernel(const uint32_t* staging, const uint64_t* offsets,
-                                      uint32_t* map) {
-  map[offsets[blockIdx.x] + threadIdx.x] =
-      staging[static_cast<size_t>(blockIdx.x) * kBrickVoxels + threadIdx.x];
+                                      uint32_t* map, uint32_t* settled, uint8_t* settled_bricks,
+                                      uint32_t settled_voxel) {
+  const size_t index = offsets[blockIdx.x] + threadIdx.x;
+  const uint32_t voxel = staging[static_cast<size_t>(blockIdx.x) * kBrickVoxels + threadIdx.x];
+  map[index] = voxel;
+  write_warp_bits(settled, index, voxel == settled_voxel);
+  const int all_settled = __syncthreads_and(voxel == settled_voxel);
+  if (threadIdx.x == 0) settled_bricks[offsets[blockIdx.x] / kBrickVoxels] = all_settled != 0;
 }
 
 class CudaIntegrator final : public Integrator {
@@ -159,7 +190,9 @@ class CudaIntegrator final : public Integrator {
     resident_blocks_ = static_cast<unsigned int>(multiprocessors) * 8u;
     map_.reserve(n);
     candidates_.reserve(n);
+    settled_.reserve(n / 32);
     const size_t bricks = n / kBrickVoxels;
+    settled_bricks_.reserve(bricks);
     brick_flags_.reserve(bricks);
     touched_bricks_.reserve(bricks);
     counters_.reserve(kCounters);
@@ -167,6 +200,8 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(
         cudaMemsetAsync(brick_flags_.data(), 0, bricks * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(map_.data(), 0, n * sizeof(uint32_t), stream_));
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(settled_.data(), 0, n / 8, stream_));
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(settled_bricks_.data(), 0, bricks, stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(candidates_.data(), 0xFF, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
   }
@@ -175,10 +210,10 @@ class CudaIntegrator final : public Integrator {
   std::string backend_name() const override { return "cuda"; }
   const LocalMapGeometry& geometry() const override { return geometry_; }
   size_t memory_bytes() const override {
-    return map_.bytes() + candidates_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
-           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
-           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes() +
-           carving_level_.bytes();
+    return map_.bytes() + candidates_.bytes() + settled_.bytes() + settled_bricks_.bytes() +
+           brick_flags_.bytes() + touched_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() +
+           origins_.bytes() + counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
+           interpolate_.bytes() + carving_level_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -211,7 +246,8 @@ class CudaIntegrator final : public Integrator {
           brick_staging_.data(), voxels.data() + first * kBrickVoxels,
           count * kBrickVoxels * sizeof(uint32_t), cudaMemcpyHostToDevice, stream_));
       scatter_bricks_kernel<<<static_cast<unsigned int>(count), kBrickVoxels, 0, stream_>>>(
-          brick_staging_.data(), brick_offsets_.data(), map_.data());
+          brick_staging_.data(), brick_offsets_.data(), map_.data(), settled_.data(),
+          settled_bricks_.data(), settled_free_voxel(settings_.max_weight_fixed()));
       FEATSENSE_CUDA_CHECK(cudaGetLastError());
       FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
     });
@@ -251,13 +287,14 @@ class CudaIntegrator final : public Integrator {
     params.truncation_m = settings_.truncation_m;
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
-    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data()};
+    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
+                                   settled_.data()};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
         origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
         settings_.carve_free_space, settings_.dense_range_m, kept_.data(), kept_count, params,
-        propose);
+        propose, settled_bricks_.data());
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     const auto brick_count = static_cast<uint32_t>(geometry_.voxel_count() / kBrickVoxels);
     list_touched_bricks_kernel<<<blocks_for(brick_count), kThreads, 0, stream_>>>(
@@ -265,7 +302,8 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kBrickVoxels, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
-        settings_.falloff_start_fixed(), settings_.max_weight_fixed(), updated_count);
+        settled_.data(), settled_bricks_.data(), settings_.falloff_start_fixed(),
+        settings_.max_weight_fixed(), updated_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
                                          kCounters * sizeof(uint32_t), cudaMemcpyDeviceToHost,
@@ -335,6 +373,8 @@ class CudaIntegrator final : public Integrator {
   cudaStream_t stream_ = nullptr;
   cuda::DeviceBuffer<uint32_t> map_;
   cuda::DeviceBuffer<uint32_t> candidates_;
+  cuda::DeviceBuffer<uint32_t> settled_;         ///< a bit per voxel of settled free space
+  cuda::DeviceBuffer<uint8_t> settled_bricks_;   ///< 1 per brick of settled free space only
   cuda::DeviceBuffer<uint32_t> brick_flags_;     ///< 1 while a brick is in touched_bricks_
   cuda::DeviceBuffer<uint32_t> touched_bricks_;  ///< bricks with a candidate this scan
   unsigned int resident_blocks_ = 1;

@@ -1,6 +1,7 @@
 // The reference integrator: rays in parallel with TBB, each thread writing the per-scan
 // minimum of the voxels of its own sectors around the sensor (plain stores, no
-// compare-exchange), fusion over the voxels this scan touched.
+// compare-exchange), fusion over the voxels this scan touched. Free-space candidates pass
+// settled free space by (voxel.hpp, settled_free_voxel), found in a bit per voxel.
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -50,6 +51,9 @@ class CpuIntegrator final : public Integrator {
         brick_owner_(geometry_.voxel_count() / kBrickVoxels, 0),
         brick_listed_(geometry_.voxel_count() / kBrickVoxels, 0),
         occupancy_(geometry_.voxel_count() / 64, 0),
+        settled_(geometry_.voxel_count() / 64, 0),
+        settled_bricks_(geometry_.voxel_count() / kBrickVoxels, 0),
+        settled_voxel_(settled_free_voxel(settings.max_weight_fixed())),
         parts_(sector_count()) {
     for (size_t i = 0; i < geometry_.voxel_count(); ++i) {
       candidates_[i].store(kEmptyCandidate, std::memory_order_relaxed);
@@ -61,8 +65,8 @@ class CpuIntegrator final : public Integrator {
   const LocalMapGeometry& geometry() const override { return geometry_; }
   std::vector<uint32_t> download() const override { return map_; }
   size_t memory_bytes() const override {
-    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + geometry_.voxel_count() / 8 +
-           2 * geometry_.voxel_count() / kBrickVoxels;
+    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + 2 * geometry_.voxel_count() / 8 +
+           3 * geometry_.voxel_count() / kBrickVoxels;
   }
 
   void read_bricks(const std::vector<Index3>& bricks,
@@ -80,6 +84,14 @@ class CpuIntegrator final : public Integrator {
     for_each_brick(bricks, [&](size_t k, size_t offset) {
       std::copy_n(voxels.begin() + static_cast<std::ptrdiff_t>(k * kBrickVoxels), kBrickVoxels,
                   map_.begin() + static_cast<std::ptrdiff_t>(offset));
+      for (size_t word = offset / 64; word < (offset + kBrickVoxels) / 64; ++word) {
+        uint64_t bits = 0;
+        for (size_t bit = 0; bit < 64; ++bit) {
+          bits |= static_cast<uint64_t>(map_[word * 64 + bit] == settled_voxel_) << bit;
+        }
+        settled_[word] = bits;
+      }
+      note_settled_brick(offset / kBrickVoxels);
     });
   }
 
@@ -224,12 +236,25 @@ class CpuIntegrator final : public Integrator {
         const size_t index = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
         const int32_t value = candidate_value(candidates_[index].load(std::memory_order_relaxed));
         candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
-        map_[index] = pack(
+        const uint32_t fused = pack(
             fuse_voxel(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
+        map_[index] = fused;
+        const uint64_t bit = uint64_t{1} << (index % 64);
+        settled_[word] = fused == settled_voxel_ ? settled_[word] | bit : settled_[word] & ~bit;
         ++updated;
       }
     }
+    note_settled_brick(brick);
     return updated;
+  }
+
+  /// Marks the brick whose voxels are all settled free space, for the walk to jump across.
+  void note_settled_brick(size_t brick) {
+    uint64_t all = ~uint64_t{0};
+    for (size_t word = brick * kWordsPerBrick; word < (brick + 1) * kWordsPerBrick; ++word) {
+      all &= settled_[word];
+    }
+    settled_bricks_[brick] = all == ~uint64_t{0} ? 1 : 0;
   }
 
   /// Sectors per thread: enough for the threads to balance their load, few enough that
@@ -291,6 +316,8 @@ class CpuIntegrator final : public Integrator {
                     const detail::RayMarchParams& params) {
     Part& part = parts_[p];
     const auto propose = [&](size_t index, int32_t value, bool interpolated) {
+      // Settled free space stays as it is (the bits are a cache line a brick, mostly cached).
+      if (value == kValueScale && ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) return;
       const uint32_t key = make_candidate(value, interpolated);
       // Candidates only fall during a scan: one at or below this key already makes it moot.
       // (Near the sensor, where every ray passes, that is nearly every visit.)
@@ -309,7 +336,8 @@ class CpuIntegrator final : public Integrator {
       detail::RayMarchParams ray = rays.may_interpolate(i) ? params : flat;
       ray.carve_from_m = detail::carving_start(settings_.carve_free_space, settings_.dense_range_m,
                                                rays.carving_level_of(i));
-      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, propose);
+      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, propose,
+                       settled_bricks_.data());
     }
   }
 
@@ -342,10 +370,13 @@ class CpuIntegrator final : public Integrator {
   /// The scan's candidates. Atomic only so that a sector may read a voxel another one writes
   /// (to drop moot candidates); every access is relaxed, plain loads and stores.
   std::unique_ptr<std::atomic<uint32_t>[]> candidates_;
-  std::vector<uint8_t> brick_owner_;   ///< the sector that writes each brick, this scan
-  std::vector<uint8_t> brick_listed_;  ///< 1 while a brick is listed for the fusion
-  std::vector<uint64_t> occupancy_;    ///< a bit per voxel that has a candidate
-  std::vector<Part> parts_;            ///< one per sector
+  std::vector<uint8_t> brick_owner_;     ///< the sector that writes each brick, this scan
+  std::vector<uint8_t> brick_listed_;    ///< 1 while a brick is listed for the fusion
+  std::vector<uint64_t> occupancy_;      ///< a bit per voxel that has a candidate
+  std::vector<uint64_t> settled_;        ///< a bit per voxel of settled free space
+  std::vector<uint8_t> settled_bricks_;  ///< 1 per brick of settled free space only
+  uint32_t settled_voxel_;               ///< what such a voxel holds
+  std::vector<Part> parts_;              ///< one per sector
 };
 
 }  // namespace

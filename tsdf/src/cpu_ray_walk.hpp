@@ -9,7 +9,10 @@
 // - of the projective distance, only the term of the axis just stepped is recomputed (each
 //   term is the same product as in march_ray, and the sum is formed in the same order);
 // - free space (d >= tau) needs no division: d / tau >= 1 there, so the clamped value is
-//   exactly kValueScale, and there is no interpolation.
+//   exactly kValueScale, and there is no interpolation;
+// - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
+//   settled_free_voxel), where every candidate would be passed by, is crossed in one jump
+//   (brick_exit), as march_ray does.
 
 #include <type_traits>
 
@@ -18,10 +21,12 @@
 namespace featsense::tsdf::detail {
 
 /// Calls visit(linear_index, value_fixed, interpolated) for every candidate march_ray would
-/// propose for this ray, in the same order.
+/// propose for this ray, in the same order, except the free-space candidates of the bricks
+/// that `settled_bricks` (nonzero per brick slot, or null) names as settled free space.
 template <typename Visit>
 inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
-                     const RayMarchParams& params, Visit&& visit) {
+                     const RayMarchParams& params, Visit&& visit,
+                     const uint8_t* settled_bricks = nullptr) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
   if (!(range > 0.0f && range < 1.0e30f)) return;
@@ -108,11 +113,48 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
 
   const float tau = params.truncation_m;
   float t = 0.0f;
+
+  const float free_from = free_space_from(t1, range, tau, vs);
+  // Jumps from the current voxel to the first one after its brick (brick_exit). Returns the
+  // steps taken, or -1 where the walk ends before it leaves the brick.
+  const auto leave_brick = [&]() -> int32_t {
+    BrickExit exit;
+    if (!brick_exit(step, local, t_next, t_delta, walk_length, exit)) return -1;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int32_t moved = step[axis] * exit.crossed[axis];
+      t_next[axis] = exit.t_next[axis];
+      voxel[axis] += moved;
+      offset[axis] += moved;
+      local[axis] += moved;
+      term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
+    }
+    t = exit.t;
+    const int a = exit.axis;
+    local[a] -= step[a] * kBrickSize;
+    brick[a] += step[a];
+    if (brick[a] == bricks[a]) brick[a] = 0;
+    if (brick[a] < 0) brick[a] = bricks[a] - 1;
+    index = static_cast<int64_t>(linear());
+    return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
+  };
+
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
+  bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
   for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
     const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
                         static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
                         static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
+    if (new_brick) {
+      new_brick = false;
+      // A brick inside the map lies wholly inside it (the map is whole bricks).
+      if (inside && t >= free_from && settled_bricks[index / kBrickVoxels] != 0) {
+        const int32_t taken = leave_brick();
+        if (taken < 0 || i + taken >= max_steps) return;
+        i += taken - 1;  // the loop adds the last one
+        new_brick = true;
+        continue;
+      }
+    }
     if (inside) {
       const float along = (term[0] + term[1]) + term[2];
       const float distance = range - along;
@@ -153,6 +195,7 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
         if (brick[axis] == bricks[axis]) brick[axis] = 0;
         if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
         index = static_cast<int64_t>(linear());
+        new_brick = settled_bricks != nullptr;
       } else {
         index += s * local_stride[axis];
       }

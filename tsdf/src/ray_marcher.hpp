@@ -74,11 +74,72 @@ FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, fl
   return t0 < t1;
 }
 
+/// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
+struct BrickExit {
+  int axis;            ///< the axis whose crossing leaves the brick
+  float t;             ///< the walk's t at that crossing
+  int32_t crossed[3];  ///< face crossings per axis up to and including it
+  float t_next[3];     ///< the next crossing per axis after them
+};
+
+/// The exit of the walk from its current brick (`local`: its place in the brick), computed
+/// without stepping through the voxels: crossings of voxel faces come in the order of their
+/// t, the lower axis first on ties (the rule of the walk's step), and each axis's crossings are
+/// the same running sums t_next += t_delta, so the state is exactly the one that stepping voxel
+/// by voxel reaches. A brick all of whose voxels would pass every candidate by can so be
+/// crossed in one jump. False where the walk ends (t > walk_length) before the exit.
+FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
+                                    const float t_next[3], const float t_delta[3],
+                                    float walk_length, BrickExit& exit) {
+  int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
+  float leave_t[3] = {0.0f, 0.0f, 0.0f};
+  exit.axis = -1;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (step[axis] == 0) continue;
+    to_leave[axis] = step[axis] > 0 ? kBrickSize - local[axis] : local[axis] + 1;
+    float tn = t_next[axis];
+    for (int32_t k = 1; k < to_leave[axis]; ++k) tn += t_delta[axis];
+    leave_t[axis] = tn;
+    if (exit.axis < 0 || tn < leave_t[exit.axis]) exit.axis = axis;
+  }
+  if (exit.axis < 0) return false;
+  exit.t = leave_t[exit.axis];
+  if (!(exit.t <= walk_length)) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    int32_t crossed = 0;
+    float tn = t_next[axis];
+    if (axis == exit.axis) {
+      crossed = to_leave[axis];
+      tn = exit.t + t_delta[axis];
+    } else if (step[axis] != 0) {
+      while (tn < exit.t || (tn == exit.t && axis < exit.axis)) {
+        tn += t_delta[axis];
+        ++crossed;
+      }
+    }
+    exit.crossed[axis] = crossed;
+    exit.t_next[axis] = tn;
+  }
+  return true;
+}
+
+/// The walk's t from which every voxel it enters is free space: a voxel's centre lies within
+/// 0.87 voxels of the ray where the ray crosses it, so from here on its distance to the end
+/// point is at least tau. t1: the ray parameter where the walk starts.
+FEATSENSE_HD_INLINE float free_space_from(float t1, float range, float truncation_m,
+                                          float voxel_size_m) {
+  return truncation_m + voxel_size_m + t1 - range;
+}
+
 /// Calls visit(linear_index, value_fixed, interpolated) for each candidate of the ray from `origin`
 /// to `endpoint` (map frame, metres). Voxels outside the local map are never visited.
+/// `settled_bricks` (nonzero per brick slot, or null): bricks of settled free space only
+/// (voxel.hpp, settled_free_voxel), where the free-space part of the walk jumps to the brick's
+/// exit instead of proposing candidates that would be passed by.
 template <typename Visit>
 FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
-                                   const RayMarchParams& params, Visit&& visit) {
+                                   const RayMarchParams& params, Visit&& visit,
+                                   const uint8_t* settled_bricks = nullptr) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
   // NaN, zero and infinite rays (a NaN or absurd point or origin) propose nothing.
@@ -133,10 +194,41 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
   const int32_t bricks[3] = {nb.x, nb.y, nb.z};
 
   const float tau = params.truncation_m;
+  const float free_from = free_space_from(t1, range, tau, vs);
   float t = 0.0f;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
+  bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
   for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
+    if (new_brick) {
+      new_brick = false;
+      BrickExit exit;
+      // A brick with one voxel inside the map lies wholly inside it (the map is whole bricks).
+      if (t >= free_from && map.contains(voxel) &&
+          settled_bricks[map.linear_from({brick[0], brick[1], brick[2]}, {0, 0, 0}) /
+                         kBrickVoxels] != 0) {
+        const int32_t taken = brick_exit(step, local, t_next, t_delta, walk_length, exit)
+                                  ? exit.crossed[0] + exit.crossed[1] + exit.crossed[2]
+                                  : -1;
+        if (taken < 0 || i + taken >= max_steps) return;
+        t = exit.t;
+        voxel.x += step[0] * exit.crossed[0];
+        voxel.y += step[1] * exit.crossed[1];
+        voxel.z += step[2] * exit.crossed[2];
+        for (int axis = 0; axis < 3; ++axis) {
+          t_next[axis] = exit.t_next[axis];
+          local[axis] += step[axis] * exit.crossed[axis];
+        }
+        const int a = exit.axis;
+        local[a] -= step[a] * kBrickSize;
+        brick[a] += step[a];
+        if (brick[a] == bricks[a]) brick[a] = 0;
+        if (brick[a] < 0) brick[a] = bricks[a] - 1;
+        i += taken - 1;  // the loop adds the last one
+        new_brick = true;
+        continue;
+      }
+    }
     if (map.contains(voxel)) {
       const Vec3 centre = map.centre_of(voxel);
       const float along = dot(centre - origin, dir);
@@ -175,6 +267,7 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
       brick[axis] += step[axis];
       if (brick[axis] == bricks[axis]) brick[axis] = 0;
       if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+      new_brick = settled_bricks != nullptr;
     }
   }
 }

@@ -14,8 +14,10 @@
 namespace featsense::tsdf {
 
 struct IntegrationStats {
-  size_t rays = 0;            ///< rays marched (after the per-voxel reduction)
-  size_t voxels_updated = 0;  ///< voxels that got a candidate from this scan
+  size_t rays = 0;  ///< rays marched (after the per-voxel reduction)
+  /// Voxels that got a candidate from this scan; not settled free space passed by
+  /// (settled_free_voxel), which the scan leaves as it is.
+  size_t voxels_updated = 0;
 };
 
 class Integrator {

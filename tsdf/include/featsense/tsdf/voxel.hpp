@@ -108,4 +108,15 @@ FEATSENSE_HD_INLINE Voxel fuse(Voxel map, int32_t value, uint32_t weight,
   return out;
 }
 
+/// A voxel of settled free space: +tau with the capped weight. Fusing +tau into it changes
+/// nothing (the average of equal values, a weight already at w_max), so the integrators let
+/// free-space candidates pass it by: the same map for much less work where the sensor keeps
+/// seeing the same free space.
+FEATSENSE_HD_INLINE uint32_t settled_free_voxel(uint32_t max_weight_fixed) {
+  Voxel v;
+  v.value = static_cast<int16_t>(kValueScale);
+  v.weight = static_cast<uint16_t>(max_weight_fixed);
+  return pack(v);
+}
+
 }  // namespace featsense::tsdf
