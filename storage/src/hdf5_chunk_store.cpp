@@ -1,5 +1,7 @@
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -190,24 +192,46 @@ void Hdf5ChunkStore::write(const ChunkKey& key, const Chunk& chunk) {
 
 void Hdf5ChunkStore::evict_if_needed() {
   const std::size_t capacity = std::max<std::size_t>(1, settings_.cache_bytes / kChunkBytes);
-  while (cache_.size() > capacity) {
-    const ChunkKey victim = lru_.back();
-    auto it = cache_.find(victim);
-    if (it->second.dirty) append_to_journal(victim, it->second.chunk);
-    lru_.pop_back();
+  if (cache_.size() <= capacity) return;
+  // Evicting a dirty chunk compresses it: several at once are compressed in parallel, so
+  // the cache is emptied down to an eighth below its limit (at most 16 chunks below).
+  const std::size_t batch = std::clamp<std::size_t>(capacity / 8, 1, 16);
+  const std::size_t target = capacity + 1 - batch;
+  std::vector<ChunkKey> victims;
+  for (auto it = lru_.rbegin(); it != lru_.rend() && cache_.size() - victims.size() > target;
+       ++it) {
+    victims.push_back(*it);
+  }
+  std::vector<std::vector<uint8_t>> payloads(victims.size());
+  tbb::parallel_for(size_t{0}, victims.size(), [&](size_t k) {
+    const CacheEntry& entry = cache_.at(victims[k]);
+    if (entry.dirty) payloads[k] = payload_of(entry.chunk);
+  });
+  for (size_t k = 0; k < victims.size(); ++k) {
+    auto it = cache_.find(victims[k]);
+    if (it->second.dirty) append_payload(victims[k], payloads[k]);
+    lru_.erase(it->second.lru);
     cache_.erase(it);
   }
 }
 
+std::vector<uint8_t> Hdf5ChunkStore::payload_of(const Chunk& chunk) const {
+  if (is_empty(chunk)) return {};
+  return detail::compress_bytes(reinterpret_cast<const uint8_t*>(chunk.voxels.data()), kChunkBytes,
+                                settings_.deflate_level);
+}
+
 void Hdf5ChunkStore::append_to_journal(const ChunkKey& key, const Chunk& chunk) {
-  if (is_empty(chunk)) {
-    journal_->append(detail::RecordType::kChunk, key, {});
+  append_payload(key, payload_of(chunk));
+}
+
+void Hdf5ChunkStore::append_payload(const ChunkKey& key, const std::vector<uint8_t>& payload) {
+  // An empty payload records a chunk that holds nothing any more.
+  const uint64_t offset = journal_->append(detail::RecordType::kChunk, key, payload);
+  if (payload.empty()) {
     stored_.erase(key);
     return;
   }
-  const auto payload = detail::compress_bytes(reinterpret_cast<const uint8_t*>(chunk.voxels.data()),
-                                              kChunkBytes, settings_.deflate_level);
-  const uint64_t offset = journal_->append(detail::RecordType::kChunk, key, payload);
   stored_[key] = Location{true, offset, static_cast<uint32_t>(payload.size())};
 }
 
@@ -227,10 +251,19 @@ void Hdf5ChunkStore::flush() {
   for (const auto& [key, entry] : cache_)
     if (entry.dirty) dirty.push_back(key);
   std::sort(dirty.begin(), dirty.end());
-  for (const auto& key : dirty) {
-    auto& entry = cache_.at(key);
-    append_to_journal(key, entry.chunk);
-    entry.dirty = false;
+  // Compression is most of a flush: the chunks of a batch are compressed in parallel, then
+  // journaled in key order by this thread.
+  constexpr size_t kBatch = 32;
+  for (size_t first = 0; first < dirty.size(); first += kBatch) {
+    const size_t count = std::min(kBatch, dirty.size() - first);
+    std::vector<std::vector<uint8_t>> payloads(count);
+    tbb::parallel_for(size_t{0}, count, [&](size_t k) {
+      payloads[k] = payload_of(cache_.at(dirty[first + k]).chunk);
+    });
+    for (size_t k = 0; k < count; ++k) {
+      append_payload(dirty[first + k], payloads[k]);
+      cache_.at(dirty[first + k]).dirty = false;
+    }
   }
   if (trajectory_dirty_) {
     journal_->append(detail::RecordType::kTrajectory, {}, trajectory_bytes(trajectory_));

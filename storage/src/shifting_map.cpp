@@ -2,9 +2,12 @@
 
 #include "featsense/tsdf/voxel.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +21,9 @@ using tsdf::kBrickVoxels;
 constexpr int32_t kBricksPerChunk = kChunkSize / kBrickSize;  // per axis
 constexpr size_t kBricksInChunk =
     static_cast<size_t>(kBricksPerChunk) * kBricksPerChunk * kBricksPerChunk;
+/// Chunks assembled or taken apart at once (1 MB each): enough to keep the cores busy, few
+/// enough that a sync of the whole local map needs little memory beyond it.
+constexpr size_t kChunksPerBatch = 32;
 
 ChunkKey chunk_of_brick(Index3 brick) {
   return chunk_of_voxel(static_cast<int64_t>(brick.x) * kBrickSize,
@@ -31,12 +37,29 @@ Index3 brick_corner_in_chunk(Index3 brick, const ChunkKey& key) {
           brick.z * kBrickSize - key.z * kChunkSize};
 }
 
+/// The bricks of one chunk: indices into the list of bricks.
+struct ChunkGroup {
+  ChunkKey key;
+  std::vector<size_t> members;
+};
+
 /// The indices into `bricks` grouped by the chunk that holds each brick, chunks in key order
 /// (so that the store is written in a reproducible order).
-std::map<ChunkKey, std::vector<size_t>> group_by_chunk(const std::vector<Index3>& bricks) {
+std::vector<ChunkGroup> group_by_chunk(const std::vector<Index3>& bricks) {
   std::map<ChunkKey, std::vector<size_t>> groups;
   for (size_t k = 0; k < bricks.size(); ++k) groups[chunk_of_brick(bricks[k])].push_back(k);
-  return groups;
+  std::vector<ChunkGroup> ordered;
+  ordered.reserve(groups.size());
+  for (auto& [key, members] : groups) ordered.push_back({key, std::move(members)});
+  return ordered;
+}
+
+/// Calls work(first, count) for consecutive batches of kChunksPerBatch groups.
+template <typename Work>
+void for_each_batch(const std::vector<ChunkGroup>& groups, const Work& work) {
+  for (size_t first = 0; first < groups.size(); first += kChunksPerBatch) {
+    work(first, std::min(kChunksPerBatch, groups.size() - first));
+  }
 }
 
 /// Brick order ((z * 8 + y) * 8 + x) into the chunk's x-fastest rows, and back.
@@ -128,7 +151,8 @@ void ShiftingMap::move_to(Index3 origin) {
       },
       [this](const std::vector<Index3>& bricks, const std::vector<uint32_t>& voxels) {
         spill(bricks, [&](size_t k) { return voxels.data() + k * kBrickVoxels; });
-      });
+      },
+      shift_buffers_);
   if (shift.bricks_left == 0) return;
   ++stats_.shifts;
   stats_.bricks_spilled += shift.bricks_left;
@@ -146,35 +170,55 @@ void ShiftingMap::sync() {
 
 template <typename VoxelsOf>
 void ShiftingMap::spill(const std::vector<Index3>& bricks, const VoxelsOf& voxels_of) {
-  for (const auto& [key, members] : group_by_chunk(bricks)) {
-    // Most of a local map is never observed: a whole chunk of such bricks where the store
-    // holds nothing needs neither assembling nor writing.
-    if (members.size() == kBricksInChunk && unchanged_in_store(key, empty_chunk_digest()) &&
-        std::all_of(members.begin(), members.end(), [&](size_t k) {
-          const uint32_t* voxels = voxels_of(k);
-          return std::all_of(voxels, voxels + kBrickVoxels,
-                             [](uint32_t v) { return tsdf::unpack(v).weight == 0; });
-        })) {
-      ++stats_.chunks_unchanged;
-      continue;
+  const std::vector<ChunkGroup> groups = group_by_chunk(bricks);
+  for_each_batch(groups, [&](size_t first, size_t count) {
+    // The store is used by this thread alone: it reads the chunks that the bricks cover only
+    // in part (the rest of such a chunk is kept) ...
+    std::vector<std::optional<Chunk>> chunks(count);
+    for (size_t i = 0; i < count; ++i) {
+      const ChunkGroup& group = groups[first + i];
+      if (group.members.size() < kBricksInChunk) {
+        std::optional<Chunk> stored = store_.read(group.key);
+        chunks[i] = stored ? std::move(stored) : Chunk{};
+      }
     }
-    Chunk chunk;
-    // A chunk the bricks cover whole needs nothing from the store.
-    if (members.size() < kBricksInChunk) {
-      if (std::optional<Chunk> stored = store_.read(key)) chunk = std::move(*stored);
+    // ... the chunks are assembled and digested in parallel ...
+    std::vector<uint64_t> digests(count);
+    tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+      const ChunkGroup& group = groups[first + i];
+      if (!chunks[i]) {
+        // Most of a local map is never observed: a whole chunk of such bricks where the store
+        // holds nothing needs neither assembling nor writing.
+        const bool unobserved =
+            std::all_of(group.members.begin(), group.members.end(), [&](size_t k) {
+              const uint32_t* voxels = voxels_of(k);
+              return std::all_of(voxels, voxels + kBrickVoxels,
+                                 [](uint32_t v) { return tsdf::unpack(v).weight == 0; });
+            });
+        if (unobserved && unchanged_in_store(group.key, empty_chunk_digest())) {
+          digests[i] = empty_chunk_digest();
+          return;
+        }
+        chunks[i] = Chunk{};
+      }
+      for (const size_t k : group.members) {
+        copy_brick_into_chunk(voxels_of(k), brick_corner_in_chunk(bricks[k], group.key),
+                              *chunks[i]);
+      }
+      digests[i] = chunk_digest(*chunks[i]);
+    });
+    // ... and those that changed are written, in key order.
+    for (size_t i = 0; i < count; ++i) {
+      const ChunkKey& key = groups[first + i].key;
+      if (unchanged_in_store(key, digests[i])) {
+        ++stats_.chunks_unchanged;
+        continue;
+      }
+      store_.write(key, *chunks[i]);
+      written_[key] = digests[i];
+      ++stats_.chunks_written;
     }
-    for (const size_t k : members) {
-      copy_brick_into_chunk(voxels_of(k), brick_corner_in_chunk(bricks[k], key), chunk);
-    }
-    const uint64_t digest = chunk_digest(chunk);
-    if (unchanged_in_store(key, digest)) {
-      ++stats_.chunks_unchanged;
-      continue;
-    }
-    store_.write(key, chunk);
-    written_[key] = digest;
-    ++stats_.chunks_written;
-  }
+  });
 }
 
 bool ShiftingMap::unchanged_in_store(const ChunkKey& key, uint64_t digest) const {
@@ -187,14 +231,19 @@ bool ShiftingMap::unchanged_in_store(const ChunkKey& key, uint64_t digest) const
 
 void ShiftingMap::load(const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
   voxels.assign(bricks.size() * kBrickVoxels, tsdf::kUnobservedVoxel);
-  for (const auto& [key, members] : group_by_chunk(bricks)) {
-    const std::optional<Chunk> chunk = store_.read(key);
-    if (!chunk) continue;
-    for (const size_t k : members) {
-      copy_brick_from_chunk(*chunk, brick_corner_in_chunk(bricks[k], key),
-                            voxels.data() + k * kBrickVoxels);
-    }
-  }
+  const std::vector<ChunkGroup> groups = group_by_chunk(bricks);
+  for_each_batch(groups, [&](size_t first, size_t count) {
+    std::vector<std::optional<Chunk>> chunks(count);
+    for (size_t i = 0; i < count; ++i) chunks[i] = store_.read(groups[first + i].key);
+    tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+      if (!chunks[i]) return;
+      const ChunkGroup& group = groups[first + i];
+      for (const size_t k : group.members) {
+        copy_brick_from_chunk(*chunks[i], brick_corner_in_chunk(bricks[k], group.key),
+                              voxels.data() + k * kBrickVoxels);
+      }
+    });
+  });
 }
 
 }  // namespace featsense::storage

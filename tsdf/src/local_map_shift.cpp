@@ -38,6 +38,12 @@ BrickExchange exchanged_bricks(const LocalMapGeometry& from, const LocalMapGeome
 
 ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
                            const BrickSink& spill) {
+  ShiftBuffers buffers;
+  return shift_local_map(map, new_origin, load, spill, buffers);
+}
+
+ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
+                           const BrickSink& spill, ShiftBuffers& buffers) {
   LocalMapGeometry target = map.geometry();
   target.origin = new_origin;
   const BrickExchange exchange = exchanged_bricks(map.geometry(), target);
@@ -46,13 +52,11 @@ ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource
   stats.bricks_entered = exchange.entering.size();
   if (exchange.leaving.empty()) return stats;
 
-  std::vector<uint32_t> leaving_voxels;
-  map.read_bricks(exchange.leaving, leaving_voxels);
-  std::vector<uint32_t> entering_voxels;
-  load(exchange.entering, entering_voxels);
+  map.read_bricks(exchange.leaving, buffers.leaving);
+  load(exchange.entering, buffers.entering);
   map.set_origin(new_origin);
-  map.write_bricks(exchange.entering, entering_voxels);
-  spill(exchange.leaving, leaving_voxels);
+  map.write_bricks(exchange.entering, buffers.entering);
+  spill(exchange.leaving, buffers.leaving);
   return stats;
 }
 

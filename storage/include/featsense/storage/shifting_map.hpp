@@ -61,6 +61,7 @@ class ShiftingMap {
   std::set<ChunkKey> keys_at_open_;                               ///< digests unknown
   std::unordered_map<ChunkKey, uint64_t, ChunkKeyHash> written_;  ///< digest of the last write
   ShiftingMapStats stats_;
+  tsdf::ShiftBuffers shift_buffers_;  ///< kept between shifts
 };
 
 /// A 64-bit digest of a chunk's voxels, to tell whether a chunk changed since it was written.

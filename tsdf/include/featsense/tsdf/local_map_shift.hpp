@@ -34,10 +34,20 @@ struct ShiftStats {
   size_t bricks_entered = 0;
 };
 
+/// The voxels of the leaving and the entering bricks. A slab of a 40 x 40 x 15 m map is
+/// tens of megabytes: kept from one shift to the next, its memory is not faulted in and
+/// zeroed again each time.
+struct ShiftBuffers {
+  std::vector<uint32_t> leaving;
+  std::vector<uint32_t> entering;
+};
+
 /// Moves `map` so that its lowest corner is `new_origin`: the leaving bricks are read and
 /// handed to `spill`, the entering ones are filled from `load`. The map is consistent
 /// whenever this returns or throws before set_origin (spill runs last, so a failing sink
 /// leaves the map moved but complete, and the caller may retry the spill).
+ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
+                           const BrickSink& spill, ShiftBuffers& buffers);
 ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
                            const BrickSink& spill);
 
