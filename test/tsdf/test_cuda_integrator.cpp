@@ -107,6 +107,9 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceWithSettledFreeSpace) {
   s.max_weight = 2.0f;
   const std::vector<RayBatch> scans = test::box_room_passes(2, 3);
   expect_same_map(s, scans, "box room, small map, settled free space");
+  TsdfSettings interpolating = s;  // interpolated candidates pass settled free space by too
+  interpolating.interpolation_slope = 0.03f;
+  expect_same_map(interpolating, scans, "box room, small map, settled free space, interpolation");
   // The CPU map written into the GPU's, brick by brick (as a shift loads the store): the
   // settled bits follow, so the next scan counts the same updates.
   auto cpu = make_cpu_integrator(s, test::make_vec(0, 0, 1.5));

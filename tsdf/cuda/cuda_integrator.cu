@@ -74,7 +74,7 @@ struct ProposeCandidate {
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
     // Settled free space stays as it is (its bits are mostly in the L1 cache).
-    if (value == kValueScale && bit_of(settled, index)) return;
+    if (passes_settled_by(value, interpolated) && bit_of(settled, index)) return;
     const uint32_t key = make_candidate(value, interpolated);
     // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
     const uint32_t current = candidates[index];

@@ -317,7 +317,10 @@ class CpuIntegrator final : public Integrator {
     Part& part = parts_[p];
     const auto propose = [&](size_t index, int32_t value, bool interpolated) {
       // Settled free space stays as it is (the bits are a cache line a brick, mostly cached).
-      if (value == kValueScale && ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) return;
+      if (passes_settled_by(value, interpolated) &&
+          ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) {
+        return;
+      }
       const uint32_t key = make_candidate(value, interpolated);
       // Candidates only fall during a scan: one at or below this key already makes it moot.
       // (Near the sensor, where every ray passes, that is nearly every visit.)

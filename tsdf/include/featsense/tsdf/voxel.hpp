@@ -110,13 +110,22 @@ FEATSENSE_HD_INLINE Voxel fuse(Voxel map, int32_t value, uint32_t weight,
 
 /// A voxel of settled free space: +tau with the capped weight. Fusing +tau into it changes
 /// nothing (the average of equal values, a weight already at w_max), so the integrators let
-/// free-space candidates pass it by: the same map for much less work where the sensor keeps
-/// seeing the same free space.
+/// free-space candidates pass it by: much less work where the sensor keeps seeing the same
+/// free space.
 FEATSENSE_HD_INLINE uint32_t settled_free_voxel(uint32_t max_weight_fixed) {
   Voxel v;
   v.value = static_cast<int16_t>(kValueScale);
   v.weight = static_cast<uint16_t>(max_weight_fixed);
   return pack(v);
+}
+
+/// Whether a candidate passes settled free space by: +tau, which would change nothing, and an
+/// interpolated one, a guess between beams that does not wear down space measured free w_max
+/// times. (Passing +tau alone would change the map: in a scan where a ray measures a settled
+/// voxel +tau and another interpolates it, the measured +tau wins and keeps the voxel; without
+/// it, the interpolated value would.) Measured values nearer the surface still update it.
+FEATSENSE_HD_INLINE bool passes_settled_by(int32_t value, bool interpolated) {
+  return value == kValueScale || interpolated;
 }
 
 }  // namespace featsense::tsdf
