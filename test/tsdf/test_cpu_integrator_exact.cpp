@@ -261,6 +261,18 @@ TEST(CpuIntegratorExact, SettledFreeSpaceIsPassedBy) {
   expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3));
 }
 
+TEST(CpuIntegratorExact, SettledFreeSpaceAtTheDefaultVoxelSize) {
+  // The sensor's own interpolation band at 6.4 cm voxels (it reaches a neighbouring voxel
+  // beyond 10.4 m, so the room's far walls are interpolated), with a map that holds the room.
+  TsdfSettings s;
+  s.map_size_m = {28.0f, 28.0f, 6.0f};
+  s.max_weight = 2.0f;
+  s.interpolation_slope = os1_interpolation_slope();
+  std::vector<size_t> updated;
+  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3), &updated);
+  EXPECT_LT(updated.back() * 3, updated.front());
+}
+
 TEST(CpuIntegratorExact, BricksWrittenBackKeepTheirSettledFreeSpace) {
   // A map that moved into another integrator (as bricks loaded from the store do) passes its
   // settled free space by as the original does: same counts, same map.
