@@ -272,7 +272,7 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(
         cudaMemsetAsync(counters_.data(), 0, kCounters * sizeof(uint32_t), stream_));
 
-    kept_.reserve(n);
+    kept_.grow(n);
     if (settings_.reduce_points_per_voxel) {
       mark_first_point_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
           endpoints_.data(), n, geometry_, candidates_.data());
@@ -319,9 +319,9 @@ class CudaIntegrator final : public Integrator {
 
   void upload(const RayBatch& rays, size_t origin_count) {
     const size_t n = rays.size();
-    staging_.reserve(n + origin_count);
-    endpoints_.reserve(n);
-    origins_.reserve(origin_count);
+    staging_.grow(n + origin_count);
+    endpoints_.grow(n);
+    origins_.grow(origin_count);
     detail::parallel_copy(staging_.data(), rays.endpoints_m.data(), n * sizeof(Vec3));
     detail::parallel_copy(staging_.data() + n, rays.origins_m.data(), origin_count * sizeof(Vec3));
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(endpoints_.data(), staging_.data(), n * sizeof(Vec3),
@@ -330,15 +330,15 @@ class CudaIntegrator final : public Integrator {
                                          origin_count * sizeof(Vec3), cudaMemcpyHostToDevice,
                                          stream_));
     if (!rays.interpolate.empty()) {
-      interpolate_staging_.reserve(n);
-      interpolate_.reserve(n);
+      interpolate_staging_.grow(n);
+      interpolate_.grow(n);
       std::memcpy(interpolate_staging_.data(), rays.interpolate.data(), n);
       FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(interpolate_.data(), interpolate_staging_.data(), n,
                                            cudaMemcpyHostToDevice, stream_));
     }
     if (!rays.carving_level.empty()) {
-      carving_level_staging_.reserve(n);
-      carving_level_.reserve(n);
+      carving_level_staging_.grow(n);
+      carving_level_.grow(n);
       std::memcpy(carving_level_staging_.data(), rays.carving_level.data(), n);
       FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(carving_level_.data(), carving_level_staging_.data(), n,
                                            cudaMemcpyHostToDevice, stream_));

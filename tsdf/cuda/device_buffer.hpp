@@ -27,6 +27,11 @@ class DeviceBuffer {
     FEATSENSE_CUDA_CHECK(cudaMalloc(reinterpret_cast<void**>(&data_), count * sizeof(T)));
     capacity_ = count;
   }
+  /// reserve() with room for a quarter more: for per-scan buffers, so that the point counts
+  /// of a recording, which vary from scan to scan, seldom reallocate.
+  void grow(size_t count) {
+    if (count > capacity_) reserve(count + count / 4);
+  }
   T* data() { return data_; }
   const T* data() const { return data_; }
   size_t capacity() const { return capacity_; }
@@ -53,6 +58,10 @@ class PinnedBuffer {
     capacity_ = 0;
     FEATSENSE_CUDA_CHECK(cudaMallocHost(reinterpret_cast<void**>(&data_), count * sizeof(T)));
     capacity_ = count;
+  }
+  /// As DeviceBuffer::grow (a page-locked allocation takes milliseconds).
+  void grow(size_t count) {
+    if (count > capacity_) reserve(count + count / 4);
   }
   T* data() { return data_; }
 
