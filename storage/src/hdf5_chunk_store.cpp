@@ -202,37 +202,40 @@ void Hdf5ChunkStore::evict_if_needed() {
        ++it) {
     victims.push_back(*it);
   }
-  std::vector<std::vector<uint8_t>> payloads(victims.size());
-  tbb::parallel_for(size_t{0}, victims.size(), [&](size_t k) {
-    const CacheEntry& entry = cache_.at(victims[k]);
-    if (entry.dirty) payloads[k] = payload_of(entry.chunk);
-  });
-  for (size_t k = 0; k < victims.size(); ++k) {
-    auto it = cache_.find(victims[k]);
-    if (it->second.dirty) append_payload(victims[k], payloads[k]);
+  std::vector<ChunkKey> dirty;
+  for (const ChunkKey& key : victims)
+    if (cache_.at(key).dirty) dirty.push_back(key);
+  journal_chunks(dirty);
+  for (const ChunkKey& key : victims) {
+    auto it = cache_.find(key);
     lru_.erase(it->second.lru);
     cache_.erase(it);
   }
 }
 
-std::vector<uint8_t> Hdf5ChunkStore::payload_of(const Chunk& chunk) const {
-  if (is_empty(chunk)) return {};
-  return detail::compress_bytes(reinterpret_cast<const uint8_t*>(chunk.voxels.data()), kChunkBytes,
-                                settings_.deflate_level);
-}
-
-void Hdf5ChunkStore::append_to_journal(const ChunkKey& key, const Chunk& chunk) {
-  append_payload(key, payload_of(chunk));
-}
-
-void Hdf5ChunkStore::append_payload(const ChunkKey& key, const std::vector<uint8_t>& payload) {
-  // An empty payload records a chunk that holds nothing any more.
-  const uint64_t offset = journal_->append(detail::RecordType::kChunk, key, payload);
-  if (payload.empty()) {
-    stored_.erase(key);
-    return;
+void Hdf5ChunkStore::journal_chunks(const std::vector<ChunkKey>& keys) {
+  constexpr size_t kBatch = 32;
+  for (size_t first = 0; first < keys.size(); first += kBatch) {
+    const size_t count = std::min(kBatch, keys.size() - first);
+    // An empty payload records a chunk that holds nothing any more.
+    std::vector<std::vector<uint8_t>> payloads(count);
+    tbb::parallel_for(size_t{0}, count, [&](size_t k) {
+      const Chunk& chunk = cache_.at(keys[first + k]).chunk;
+      if (!is_empty(chunk)) {
+        payloads[k] = detail::compress_bytes(reinterpret_cast<const uint8_t*>(chunk.voxels.data()),
+                                             kChunkBytes, settings_.deflate_level);
+      }
+    });
+    for (size_t k = 0; k < count; ++k) {
+      const ChunkKey& key = keys[first + k];
+      const uint64_t offset = journal_->append(detail::RecordType::kChunk, key, payloads[k]);
+      if (payloads[k].empty()) {
+        stored_.erase(key);
+      } else {
+        stored_[key] = Location{true, offset, static_cast<uint32_t>(payloads[k].size())};
+      }
+    }
   }
-  stored_[key] = Location{true, offset, static_cast<uint32_t>(payload.size())};
 }
 
 std::vector<ChunkKey> Hdf5ChunkStore::keys() const {
@@ -251,20 +254,8 @@ void Hdf5ChunkStore::flush() {
   for (const auto& [key, entry] : cache_)
     if (entry.dirty) dirty.push_back(key);
   std::sort(dirty.begin(), dirty.end());
-  // Compression is most of a flush: the chunks of a batch are compressed in parallel, then
-  // journaled in key order by this thread.
-  constexpr size_t kBatch = 32;
-  for (size_t first = 0; first < dirty.size(); first += kBatch) {
-    const size_t count = std::min(kBatch, dirty.size() - first);
-    std::vector<std::vector<uint8_t>> payloads(count);
-    tbb::parallel_for(size_t{0}, count, [&](size_t k) {
-      payloads[k] = payload_of(cache_.at(dirty[first + k]).chunk);
-    });
-    for (size_t k = 0; k < count; ++k) {
-      append_payload(dirty[first + k], payloads[k]);
-      cache_.at(dirty[first + k]).dirty = false;
-    }
-  }
+  journal_chunks(dirty);
+  for (const ChunkKey& key : dirty) cache_.at(key).dirty = false;
   if (trajectory_dirty_) {
     journal_->append(detail::RecordType::kTrajectory, {}, trajectory_bytes(trajectory_));
     trajectory_dirty_ = false;

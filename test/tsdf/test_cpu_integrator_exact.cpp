@@ -282,10 +282,7 @@ TEST(CpuIntegratorExact, BricksWrittenBackKeepTheirSettledFreeSpace) {
   auto original = make_cpu_integrator(s, test::make_vec(-2, 0, 1.5));
   for (size_t i = 0; i + 1 < scans.size(); ++i) original->integrate(scans[i]);
   auto copy = make_cpu_integrator(s, test::make_vec(-2, 0, 1.5));
-  const std::vector<Index3> bricks = test::all_bricks(original->geometry());
-  std::vector<uint32_t> voxels;
-  original->read_bricks(bricks, voxels);
-  copy->write_bricks(bricks, voxels);
+  test::copy_all_bricks(*original, *copy);
   EXPECT_EQ(original->integrate(scans.back()).voxels_updated,
             copy->integrate(scans.back()).voxels_updated);
   EXPECT_TRUE(original->download() == copy->download());

@@ -115,10 +115,7 @@ TEST(CudaIntegrator, SameMapAsTheCpuReferenceWithSettledFreeSpace) {
   auto cpu = make_cpu_integrator(s, test::make_vec(0, 0, 1.5));
   for (const RayBatch& scan : scans) cpu->integrate(scan);
   auto gpu = make_cuda_integrator(s, test::make_vec(0, 0, 1.5));
-  const std::vector<Index3> bricks = test::all_bricks(cpu->geometry());
-  std::vector<uint32_t> voxels;
-  cpu->read_bricks(bricks, voxels);
-  gpu->write_bricks(bricks, voxels);
+  test::copy_all_bricks(*cpu, *gpu);
   EXPECT_EQ(cpu->integrate(scans.front()).voxels_updated,
             gpu->integrate(scans.front()).voxels_updated);
   const Difference d = compare(cpu->download(), gpu->download());

@@ -42,6 +42,15 @@ inline std::vector<Index3> all_bricks(const LocalMapGeometry& g) {
   return bricks;
 }
 
+/// Writes every brick of `from` into `to` (a map of the same geometry), as a shift loads
+/// bricks from the store.
+inline void copy_all_bricks(const Integrator& from, Integrator& to) {
+  const std::vector<Index3> bricks = all_bricks(from.geometry());
+  std::vector<uint32_t> voxels;
+  from.read_bricks(bricks, voxels);
+  to.write_bricks(bricks, voxels);
+}
+
 /// Calls f for every voxel of the map (observed or not).
 inline void for_each_voxel(const Integrator& integrator, float truncation_m,
                            const std::function<void(const ObservedVoxel&)>& f) {

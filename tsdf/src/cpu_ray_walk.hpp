@@ -129,11 +129,7 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
       term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
     }
     t = exit.t;
-    const int a = exit.axis;
-    local[a] -= step[a] * kBrickSize;
-    brick[a] += step[a];
-    if (brick[a] == bricks[a]) brick[a] = 0;
-    if (brick[a] < 0) brick[a] = bricks[a] - 1;
+    enter_next_brick(local[exit.axis], brick[exit.axis], step[exit.axis], bricks[exit.axis]);
     index = static_cast<int64_t>(linear());
     return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
   };
@@ -190,10 +186,7 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
       term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
       local[axis] += s;
       if (local[axis] == kBrickSize || local[axis] < 0) {
-        local[axis] -= s * kBrickSize;
-        brick[axis] += s;
-        if (brick[axis] == bricks[axis]) brick[axis] = 0;
-        if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+        enter_next_brick(local[axis], brick[axis], s, bricks[axis]);
         index = static_cast<int64_t>(linear());
         new_brick = settled_bricks != nullptr;
       } else {

@@ -74,6 +74,16 @@ FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, fl
   return t0 < t1;
 }
 
+/// Along one axis, a step of `step` (+-1) that left the brick: the place in the brick moves to
+/// the near side of the next brick, whose ring-buffer slot wraps around `bricks` slots.
+FEATSENSE_HD_INLINE void enter_next_brick(int32_t& local, int32_t& brick, int32_t step,
+                                          int32_t bricks) {
+  local -= step * kBrickSize;
+  brick += step;
+  if (brick == bricks) brick = 0;
+  if (brick < 0) brick = bricks - 1;
+}
+
 /// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
 struct BrickExit {
   int axis;            ///< the axis whose crossing leaves the brick
@@ -220,10 +230,7 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
           local[axis] += step[axis] * exit.crossed[axis];
         }
         const int a = exit.axis;
-        local[a] -= step[a] * kBrickSize;
-        brick[a] += step[a];
-        if (brick[a] == bricks[a]) brick[a] = 0;
-        if (brick[a] < 0) brick[a] = bricks[a] - 1;
+        enter_next_brick(local[a], brick[a], step[a], bricks[a]);
         i += taken - 1;  // the loop adds the last one
         new_brick = true;
         continue;
@@ -263,10 +270,7 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     if (axis == 2) voxel.z += step[2];
     local[axis] += step[axis];
     if (local[axis] == kBrickSize || local[axis] < 0) {
-      local[axis] -= step[axis] * kBrickSize;
-      brick[axis] += step[axis];
-      if (brick[axis] == bricks[axis]) brick[axis] = 0;
-      if (brick[axis] < 0) brick[axis] = bricks[axis] - 1;
+      enter_next_brick(local[axis], brick[axis], step[axis], bricks[axis]);
       new_brick = settled_bricks != nullptr;
     }
   }

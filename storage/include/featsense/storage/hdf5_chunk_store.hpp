@@ -94,10 +94,9 @@ class Hdf5ChunkStore final : public ChunkStore {
   void require_writable(const char* what) const;
   void touch(CacheEntry& entry);
   void evict_if_needed();
-  void append_to_journal(const ChunkKey& key, const Chunk& chunk);
-  /// A chunk's journal payload: compressed voxels, or nothing for a chunk that holds nothing.
-  std::vector<uint8_t> payload_of(const Chunk& chunk) const;
-  void append_payload(const ChunkKey& key, const std::vector<uint8_t>& payload);
+  /// Appends the cached chunks of `keys` to the journal, in that order. Compression, most of
+  /// the work, runs in parallel, a batch of chunks at a time.
+  void journal_chunks(const std::vector<ChunkKey>& keys);
   Chunk load(const ChunkKey& key, const Location& where) const;
 
   std::filesystem::path path_;
