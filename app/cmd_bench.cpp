@@ -39,9 +39,9 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
   const std::array<double, 3> size = parse_map_size(options.map_size);
   const config::Config config = bench_config(context, size, options.voxel_size_m, options.backend);
 
-  const PreparedScans scans = options.input.input.empty()
-                                  ? prepare_builtin(options.scene, options.scans)
-                                  : prepare_recording(options.input, config, options.scans);
+  PreparedScans scans = options.input.input.empty()
+                            ? prepare_builtin(options.scene, options.scans)
+                            : prepare_recording(options.input, config, options.scans);
   const tsdf::TsdfSettings settings = tsdf::TsdfSettings::from_config(config.map, scans.sensor);
   // The map is centred on the middle of the sensor's path, so that it holds the whole
   // sequence without shifting.
@@ -56,6 +56,9 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
     warm_up->integrate(scans.rays.front());
   }
   spdlog::info("{}", why);
+  // Prepared before an integrator existed, the scans' arrays move into the memory a run's
+  // scans get from then on (page-locked where the integrator is CUDA's: tsdf/host_memory.hpp).
+  for (tsdf::RayBatch& batch : scans.rays) batch = tsdf::RayBatch(batch);
 
   // Each pass integrates the sequence in order, every scan once, into a new map: what the
   // integrator does in a run, where a scan meets the map that the scans before it left.

@@ -14,9 +14,10 @@
 #include "brick_checks.hpp"
 #include "cuda_check.hpp"
 #include "device_buffer.hpp"
+#include "featsense/tsdf/host_memory.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "parallel_copy.hpp"
-#include "ray_marcher.hpp"
+#include "ray_walk.hpp"
 
 namespace featsense::tsdf {
 namespace {
@@ -73,11 +74,15 @@ struct ProposeCandidate {
   const uint32_t* settled;
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
-    // Settled free space stays as it is (its bits are mostly in the L1 cache).
-    if (passes_settled_by(value, interpolated) && bit_of(settled, index)) return;
-    const uint32_t key = make_candidate(value, interpolated);
-    // Keys only decrease during a scan, so a stale read can only cause an unneeded atomic.
+    // Both loads are issued before either is needed, so the walk waits for memory once per
+    // voxel, not twice. Keys only decrease during a scan, so a stale read can only cause an
+    // unneeded atomic.
     const uint32_t current = candidates[index];
+    const uint32_t settled_word =
+        passes_settled_by(value, interpolated) ? __ldg(&settled[index / 32]) : 0u;
+    // Settled free space stays as it is (its bits are mostly in the L1 cache).
+    if (((settled_word >> (index % 32)) & 1u) != 0u) return;
+    const uint32_t key = make_candidate(value, interpolated);
     if (current <= key) return;
     // The old value is not needed, so the minimum is a reduction the thread does not wait for.
     atomicMin(&candidates[index], key);
@@ -102,11 +107,15 @@ __global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, uint32_t
   if (touched) touched_bricks[first + __popc(lanes & ((1u << lane) - 1u))] = i;
 }
 
-__global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
-                                const uint8_t* interpolate, const uint8_t* carving_level,
-                                bool carve_free_space, float dense_range_m, const uint32_t* kept,
-                                const uint32_t* kept_count, detail::RayMarchParams params,
-                                ProposeCandidate propose, const uint8_t* settled_bricks) {
+// At most 64 registers, so that four blocks share a multiprocessor: on an H100 or H200 (132
+// of them) every ray of an OS1-128 scan is then walked in one wave. (A walk without the limit
+// takes 80 registers, three blocks: a second wave for the last rays.)
+__global__ void __launch_bounds__(kThreads, 4)
+    min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
+                    const uint8_t* interpolate, const uint8_t* carving_level, bool carve_free_space,
+                    float dense_range_m, const uint32_t* kept, const uint32_t* kept_count,
+                    detail::RayMarchParams params, ProposeCandidate propose,
+                    const uint8_t* settled_bricks) {
   const uint32_t count = *kept_count;
   detail::RayMarchParams flat = params;
   flat.interpolation_slope = 0.0f;
@@ -117,8 +126,8 @@ __global__ void min_tsdf_kernel(const Vec3* origins, bool origin_per_point, cons
     ray.carve_from_m =
         detail::carving_start(carve_free_space, dense_range_m,
                               carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
-    detail::march_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose,
-                      settled_bricks);
+    detail::walk_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose,
+                     settled_bricks);
   }
 }
 
@@ -175,12 +184,20 @@ __global__ void scatter_bricks_kernel(const uint32_t* staging, const uint64_t* o
   if (threadIdx.x == 0) settled_bricks[offsets[blockIdx.x] / kBrickVoxels] = all_settled != 0;
 }
 
+void* allocate_page_locked(size_t bytes) {
+  void* block = nullptr;
+  return cudaMallocHost(&block, bytes) == cudaSuccess ? block : nullptr;
+}
+
+void release_page_locked(void* block) { cudaFreeHost(block); }
+
 class CudaIntegrator final : public Integrator {
  public:
   CudaIntegrator(const TsdfSettings& settings, Vec3 centre_m)
       : settings_(settings), geometry_(centred_geometry(settings, centre_m)) {
     const size_t n = geometry_.voxel_count();
     FEATSENSE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+    host_memory::enable_page_locking({&allocate_page_locked, &release_page_locked});
     int device = 0;
     int multiprocessors = 0;
     FEATSENSE_CUDA_CHECK(cudaGetDevice(&device));
@@ -319,30 +336,32 @@ class CudaIntegrator final : public Integrator {
 
   void upload(const RayBatch& rays, size_t origin_count) {
     const size_t n = rays.size();
-    staging_.grow(n + origin_count);
     endpoints_.grow(n);
     origins_.grow(origin_count);
-    detail::parallel_copy(staging_.data(), rays.endpoints_m.data(), n * sizeof(Vec3));
-    detail::parallel_copy(staging_.data() + n, rays.origins_m.data(), origin_count * sizeof(Vec3));
-    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(endpoints_.data(), staging_.data(), n * sizeof(Vec3),
-                                         cudaMemcpyHostToDevice, stream_));
-    FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(origins_.data(), staging_.data() + n,
-                                         origin_count * sizeof(Vec3), cudaMemcpyHostToDevice,
-                                         stream_));
+    upload_array(endpoints_.data(), rays.endpoints_m.data(), n, endpoint_staging_);
+    upload_array(origins_.data(), rays.origins_m.data(), origin_count, origin_staging_);
     if (!rays.interpolate.empty()) {
-      interpolate_staging_.grow(n);
       interpolate_.grow(n);
-      std::memcpy(interpolate_staging_.data(), rays.interpolate.data(), n);
-      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(interpolate_.data(), interpolate_staging_.data(), n,
-                                           cudaMemcpyHostToDevice, stream_));
+      upload_array(interpolate_.data(), rays.interpolate.data(), n, interpolate_staging_);
     }
     if (!rays.carving_level.empty()) {
-      carving_level_staging_.grow(n);
       carving_level_.grow(n);
-      std::memcpy(carving_level_staging_.data(), rays.carving_level.data(), n);
-      FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(carving_level_.data(), carving_level_staging_.data(), n,
-                                           cudaMemcpyHostToDevice, stream_));
+      upload_array(carving_level_.data(), rays.carving_level.data(), n, carving_level_staging_);
     }
+  }
+
+  /// One DMA from page-locked memory (host_memory.hpp, where a RayBatch's arrays are once this
+  /// integrator exists); other memory is copied into a page-locked staging buffer first.
+  template <typename T>
+  void upload_array(T* device, const T* host, size_t count, cuda::PinnedBuffer<T>& staging) {
+    const T* source = host;
+    if (!host_memory::is_page_locked(host)) {
+      staging.grow(count);
+      detail::parallel_copy(staging.data(), host, count * sizeof(T));
+      source = staging.data();
+    }
+    FEATSENSE_CUDA_CHECK(
+        cudaMemcpyAsync(device, source, count * sizeof(T), cudaMemcpyHostToDevice, stream_));
   }
 
   void fill_identity(uint32_t n, uint32_t* kept_count);
@@ -383,7 +402,8 @@ class CudaIntegrator final : public Integrator {
   cuda::PinnedBuffer<uint32_t> host_counters_;
   cuda::DeviceBuffer<Vec3> endpoints_;
   cuda::DeviceBuffer<Vec3> origins_;
-  cuda::PinnedBuffer<Vec3> staging_;
+  cuda::PinnedBuffer<Vec3> endpoint_staging_;  ///< for end points not in page-locked memory
+  cuda::PinnedBuffer<Vec3> origin_staging_;
   cuda::DeviceBuffer<uint8_t> interpolate_;  ///< per end point, when the batch has flags
   cuda::PinnedBuffer<uint8_t> interpolate_staging_;
   cuda::DeviceBuffer<uint8_t> carving_level_;  ///< per end point, when the batch has levels

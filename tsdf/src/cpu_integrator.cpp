@@ -15,7 +15,7 @@
 #include <memory>
 
 #include "brick_checks.hpp"
-#include "cpu_ray_walk.hpp"
+#include "ray_walk.hpp"
 #include "featsense/tsdf/integrator.hpp"
 
 namespace featsense::tsdf {

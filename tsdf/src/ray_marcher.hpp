@@ -101,19 +101,21 @@ struct BrickExit {
 FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
                                     const float t_next[3], const float t_delta[3],
                                     float walk_length, BrickExit& exit) {
+  // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
   int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
-  float leave_t[3] = {0.0f, 0.0f, 0.0f};
   exit.axis = -1;
+  exit.t = 0.0f;
   for (int axis = 0; axis < 3; ++axis) {
     if (step[axis] == 0) continue;
     to_leave[axis] = step[axis] > 0 ? kBrickSize - local[axis] : local[axis] + 1;
     float tn = t_next[axis];
     for (int32_t k = 1; k < to_leave[axis]; ++k) tn += t_delta[axis];
-    leave_t[axis] = tn;
-    if (exit.axis < 0 || tn < leave_t[exit.axis]) exit.axis = axis;
+    if (exit.axis < 0 || tn < exit.t) {
+      exit.axis = axis;
+      exit.t = tn;
+    }
   }
   if (exit.axis < 0) return false;
-  exit.t = leave_t[exit.axis];
   if (!(exit.t <= walk_length)) return false;
   for (int axis = 0; axis < 3; ++axis) {
     int32_t crossed = 0;
@@ -142,14 +144,12 @@ FEATSENSE_HD_INLINE float free_space_from(float t1, float range, float truncatio
 }
 
 /// Calls visit(linear_index, value_fixed, interpolated) for each candidate of the ray from `origin`
-/// to `endpoint` (map frame, metres). Voxels outside the local map are never visited.
-/// `settled_bricks` (nonzero per brick slot, or null): bricks of settled free space only
-/// (voxel.hpp, settled_free_voxel), where the free-space part of the walk jumps to the brick's
-/// exit instead of proposing candidates that would be passed by.
+/// to `endpoint` (map frame, metres). Voxels outside the local map are never visited. The
+/// plain statement of the rule: the integrators run walk_ray (ray_walk.hpp), which proposes the
+/// same candidates with less work, and the tests check it against this.
 template <typename Visit>
 FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
-                                   const RayMarchParams& params, Visit&& visit,
-                                   const uint8_t* settled_bricks = nullptr) {
+                                   const RayMarchParams& params, Visit&& visit) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
   // NaN, zero and infinite rays (a NaN or absurd point or origin) propose nothing.
@@ -195,55 +195,18 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     }
   }
 
-  // Brick slot and place in the brick follow the traversal incrementally: no division per step.
-  const Index3 start_brick = map.wrapped_brick(voxel);
-  const Index3 start_local = LocalMapGeometry::local_in_brick(voxel);
-  int32_t brick[3] = {start_brick.x, start_brick.y, start_brick.z};
-  int32_t local[3] = {start_local.x, start_local.y, start_local.z};
-  const Index3 nb = map.bricks();
-  const int32_t bricks[3] = {nb.x, nb.y, nb.z};
-
   const float tau = params.truncation_m;
-  const float free_from = free_space_from(t1, range, tau, vs);
   float t = 0.0f;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
   for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
-    if (new_brick) {
-      new_brick = false;
-      BrickExit exit;
-      // A brick with one voxel inside the map lies wholly inside it (the map is whole bricks).
-      if (t >= free_from && map.contains(voxel) &&
-          settled_bricks[map.linear_from({brick[0], brick[1], brick[2]}, {0, 0, 0}) /
-                         kBrickVoxels] != 0) {
-        const int32_t taken = brick_exit(step, local, t_next, t_delta, walk_length, exit)
-                                  ? exit.crossed[0] + exit.crossed[1] + exit.crossed[2]
-                                  : -1;
-        if (taken < 0 || i + taken >= max_steps) return;
-        t = exit.t;
-        voxel.x += step[0] * exit.crossed[0];
-        voxel.y += step[1] * exit.crossed[1];
-        voxel.z += step[2] * exit.crossed[2];
-        for (int axis = 0; axis < 3; ++axis) {
-          t_next[axis] = exit.t_next[axis];
-          local[axis] += step[axis] * exit.crossed[axis];
-        }
-        const int a = exit.axis;
-        enter_next_brick(local[a], brick[a], step[a], bricks[a]);
-        i += taken - 1;  // the loop adds the last one
-        new_brick = true;
-        continue;
-      }
-    }
     if (map.contains(voxel)) {
       const Vec3 centre = map.centre_of(voxel);
       const float along = dot(centre - origin, dir);
       const float distance = range - along;
       if (distance >= -tau) {
         const int32_t value = distance_to_fixed(distance, tau);
-        visit(map.linear_from({brick[0], brick[1], brick[2]}, {local[0], local[1], local[2]}),
-              value, false);
+        visit(map.linear(voxel), value, false);
         // Fill between the scan lines only near the surface: free space far in front is
         // carved by the rays themselves, and widening every ray there costs more than it gives.
         if (interpolate && distance < tau) {
@@ -268,11 +231,6 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
     if (axis == 0) voxel.x += step[0];
     if (axis == 1) voxel.y += step[1];
     if (axis == 2) voxel.z += step[2];
-    local[axis] += step[axis];
-    if (local[axis] == kBrickSize || local[axis] < 0) {
-      enter_next_brick(local[axis], brick[axis], step[axis], bricks[axis]);
-      new_brick = settled_bricks != nullptr;
-    }
   }
 }
 

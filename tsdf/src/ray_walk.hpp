@@ -1,9 +1,10 @@
 #pragma once
-// The CPU's walk of one ray: exactly the candidates of detail::march_ray (ray_marcher.hpp,
-// which the CUDA kernel compiles), computed with less work per voxel. The float operations
-// that decide which voxels are visited and what they get are the same ones in the same order,
-// so the results are bit for bit the same (test_cpu_integrator_exact checks it against
-// march_ray itself); only bookkeeping is cheaper:
+// The walk of one ray that both backends run: exactly the candidates of detail::march_ray
+// (ray_marcher.hpp, the plain statement of the rule, which the tests use as the reference),
+// computed with less work per voxel. The float operations that decide which voxels are
+// visited and what they get are the same ones in the same order, so the results are bit for
+// bit the same (test_cpu_integrator_exact checks it against march_ray itself); only
+// bookkeeping is cheaper:
 // - the storage index and the map-bounds test follow the traversal incrementally instead of
 //   being recomputed from the global index at every voxel;
 // - of the projective distance, only the term of the axis just stepped is recomputed (each
@@ -12,7 +13,9 @@
 //   exactly kValueScale, and there is no interpolation;
 // - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
 //   settled_free_voxel), where every candidate would be passed by, is crossed in one jump
-//   (brick_exit), as march_ray does.
+//   (brick_exit), which computes the state that stepping through it would reach;
+// - every array is indexed by constants only (one code path per stepped axis), so the
+//   traversal state stays in registers, on the GPU too (no local memory).
 
 #include <type_traits>
 
@@ -24,9 +27,9 @@ namespace featsense::tsdf::detail {
 /// propose for this ray, in the same order, except the free-space candidates of the bricks
 /// that `settled_bricks` (nonzero per brick slot, or null) names as settled free space.
 template <typename Visit>
-inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
-                     const RayMarchParams& params, Visit&& visit,
-                     const uint8_t* settled_bricks = nullptr) {
+FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
+                                  const RayMarchParams& params, Visit&& visit,
+                                  const uint8_t* settled_bricks = nullptr) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
   if (!(range > 0.0f && range < 1.0e30f)) return;
@@ -129,7 +132,9 @@ inline void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
       term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
     }
     t = exit.t;
-    enter_next_brick(local[exit.axis], brick[exit.axis], step[exit.axis], bricks[exit.axis]);
+    for (int axis = 0; axis < 3; ++axis) {  // constant indices keep the arrays in registers
+      if (axis == exit.axis) enter_next_brick(local[axis], brick[axis], step[axis], bricks[axis]);
+    }
     index = static_cast<int64_t>(linear());
     return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
   };
