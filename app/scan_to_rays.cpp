@@ -82,19 +82,32 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
   rays.interpolate.reserve(scan.valid_count());
   rays.carving_level.reserve(scan.valid_count());
   const std::vector<uint8_t> flags = interpolation_flags(scan);
+  // All rows of a column share the column's time in the layout of scan.hpp; take the time
+  // of the first valid point so sources with per-point times are honoured per column.
+  std::vector<std::optional<Eigen::Isometry3d>> column_pose(static_cast<size_t>(scan.cols));
   for (int col = 0; col < scan.cols; ++col) {
-    // All rows of a column share the column's time in the layout of scan.hpp; take the time
-    // of the first valid point so sources with per-point times are honoured per column.
-    std::optional<Eigen::Isometry3d> pose;
     for (int row = 0; row < scan.rows; ++row) {
       const size_t i = scan.index(row, col);
       if (!scan.valid[i]) continue;
-      if (!pose) pose = pose_at(static_cast<double>(scan.time_offset_s[i]));
-      rays.endpoints_m.push_back(to_vec(*pose * scan.xyz[i].cast<double>()));
-      rays.origins_m.push_back(to_vec(pose->translation()));
-      rays.interpolate.push_back(flags[i]);
-      rays.carving_level.push_back(carving_level(row, col));
+      column_pose[static_cast<size_t>(col)] = pose_at(static_cast<double>(scan.time_offset_s[i]));
+      break;
     }
+  }
+  const auto add = [&](int row, int col) {
+    const size_t i = scan.index(row, col);
+    if (!scan.valid[i]) return;
+    const Eigen::Isometry3d& pose = *column_pose[static_cast<size_t>(col)];
+    rays.endpoints_m.push_back(to_vec(pose * scan.xyz[i].cast<double>()));
+    rays.origins_m.push_back(to_vec(pose.translation()));
+    rays.interpolate.push_back(flags[i]);
+    rays.carving_level.push_back(carving_level(row, col));
+  };
+  // Row by row, as scan_to_rays: neighbouring rays are the same beam in neighbouring columns,
+  // of about the same length and through the same bricks, so the rays a GPU warp walks
+  // together take about as long (column by column, a warp held 32 beams from the sky to the
+  // ground, and the GPU took 15 % longer outdoors, 25 % indoors).
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) add(row, col);
   }
   return rays;
 }

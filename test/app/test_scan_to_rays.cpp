@@ -85,21 +85,53 @@ TEST(ScanToRays, CarvingLevelsFormALatticeOfBeamsAndColumns) {
       deskewed_scan_to_rays(scan, [](double) { return Eigen::Isometry3d::Identity(); });
   ASSERT_EQ(deskewed.carving_level.size(), 63u);
   size_t k = 0;
-  for (int row = 0; row < 8; ++row) {
+  for (int row = 0; row < 8; ++row) {  // both come row by row
     for (int col = 0; col < 8; ++col) {
       if (row == 2 && col == 4) continue;
-      EXPECT_EQ(rays.carving_level[k++], expected(row, col)) << row << ", " << col;
-    }
-  }
-  k = 0;
-  for (int col = 0; col < 8; ++col) {  // the deskewed rays come column by column
-    for (int row = 0; row < 8; ++row) {
-      if (row == 2 && col == 4) continue;
-      EXPECT_EQ(deskewed.carving_level[k++], expected(row, col)) << row << ", " << col;
+      EXPECT_EQ(rays.carving_level[k], expected(row, col)) << row << ", " << col;
+      EXPECT_EQ(deskewed.carving_level[k], expected(row, col)) << row << ", " << col;
+      ++k;
     }
   }
   EXPECT_EQ(rays.carving_level[0], tsdf::kFullCarvingLevel);
   EXPECT_EQ(rays.carving_level[4 * 8 + 4 - 1], 2) << "(4, 4)";  // one cell before is missing
+}
+
+TEST(ScanToRays, DeskewedRaysStartWhereTheSensorWasWhenTheirColumnFired) {
+  // 4 beams x 6 columns, column c fired at 0.1 c s while the sensor moved 1 m/s along x;
+  // column 3 has no valid point. Each ray starts at its column's position and its end point
+  // moved with it, row by row; the pose is asked for once per column with a point.
+  slam::Scan scan = slam::Scan::allocate(4, 6);
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 6; ++col) {
+      const size_t i = scan.index(row, col);
+      scan.time_offset_s[i] = 0.1f * static_cast<float>(col);
+      if (col == 3 || (row == 0 && col == 1)) continue;
+      scan.valid[i] = 1;
+      scan.xyz[i] = Eigen::Vector3f(4.0f, static_cast<float>(col), static_cast<float>(row));
+      scan.range_m[i] = scan.xyz[i].norm();
+    }
+  }
+  int poses_asked = 0;
+  const tsdf::RayBatch rays = deskewed_scan_to_rays(scan, [&](double seconds) {
+    ++poses_asked;
+    return Eigen::Isometry3d(Eigen::Translation3d(seconds, 0.0, 0.0));
+  });
+  EXPECT_EQ(poses_asked, 1 + 5);  // the sensor's up axis at the stamp, then each column
+  ASSERT_EQ(rays.size(), 19u);
+  ASSERT_EQ(rays.origins_m.size(), 19u);
+  size_t k = 0;
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 6; ++col) {
+      if (col == 3 || (row == 0 && col == 1)) continue;
+      const float x = 0.1f * static_cast<float>(col);
+      EXPECT_FLOAT_EQ(rays.origins_m[k].x, x) << row << ", " << col;
+      EXPECT_FLOAT_EQ(rays.endpoints_m[k].x, 4.0f + x) << row << ", " << col;
+      EXPECT_FLOAT_EQ(rays.endpoints_m[k].y, static_cast<float>(col));
+      EXPECT_FLOAT_EQ(rays.endpoints_m[k].z, static_cast<float>(row));
+      ++k;
+    }
+  }
 }
 
 }  // namespace
