@@ -15,8 +15,8 @@
 #include <memory>
 
 #include "brick_checks.hpp"
-#include "ray_walk.hpp"
 #include "featsense/tsdf/integrator.hpp"
+#include "ray_walk.hpp"
 
 namespace featsense::tsdf {
 namespace {
