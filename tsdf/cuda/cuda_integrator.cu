@@ -1,8 +1,9 @@
 // The CUDA integrator: the same rule as the CPU reference (voxel.hpp, ray_walk.hpp) in
 // five kernels per scan: keep one end point per voxel (two), the per-scan minimum (atomicMin
-// on the ordered candidate keys), the list of touched bricks, and the fusion of their voxels
-// with the reset of the candidates. Free-space candidates pass settled free space by
-// (voxel.hpp, settled_free_voxel), found in a bit per voxel that the fusion keeps.
+// on the ordered candidate keys; free space, whose key is always +tau, as a bit per voxel),
+// the list of touched bricks, and the fusion of their voxels with the reset of the
+// candidates. Free-space candidates pass settled free space by (voxel.hpp,
+// settled_free_voxel), found in a bit per voxel that the fusion keeps.
 
 #include <cuda_runtime.h>
 
@@ -63,11 +64,15 @@ __device__ void write_warp_bits(uint32_t* bits, size_t index, bool bit) {
   if (threadIdx.x % 32u == 0u) bits[index / 32] = word;
 }
 
+/// The key of free space: +tau, measured. Every free-space visit proposes exactly it.
+constexpr uint32_t kFreeSpaceKey = static_cast<uint32_t>(kValueScale) << 16;
+
 struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;
   uint32_t* brick_flags;
   const uint32_t* settled;
+  uint32_t* free_space;  ///< a bit per voxel that a ray passed in free space this scan
 
   __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
     // Both loads are issued before either is needed, so the walk waits for memory once per
@@ -85,6 +90,44 @@ struct ProposeCandidate {
     // Mark the brick for the fusion. The thread whose minimum lands first on an empty voxel
     // read it empty (nothing had landed before), so every touched brick gets marked.
     if (current == kEmptyCandidate) brick_flags[index / kBrickVoxels] = 1u;
+  }
+};
+
+/// A thread's visitor: free space goes to a bit per voxel, the rest to ProposeCandidate.
+/// Free space is most of a walk, and every free-space visit proposes the same key (+tau,
+/// measured), so the scan's minimum only needs to know which voxels were passed: the fusion
+/// takes min(candidate, +tau) where the bit is set, the same as if each visit had been an
+/// atomicMin. The bits of the voxels in one 32-bit word (4 x 8 voxels of a brick) are
+/// gathered while the walk stays in that word and then set with one atomicOr that the thread
+/// does not wait for, so a free-space step waits for no memory at all (a candidate waits for
+/// its key's load). Settled free space is left out: its bits, loaded on entering a word, are
+/// cleared before the atomicOr.
+struct WalkVisitor {
+  const ProposeCandidate& propose;
+  uint32_t word = 0xFFFFFFFFu;  // the word being gathered, none yet
+  uint32_t bits = 0;
+  uint32_t settled_word = 0;
+
+  __device__ void operator()(size_t index, int32_t value, bool interpolated) {
+    if (value != kValueScale || interpolated) {
+      propose(index, value, interpolated);
+      return;
+    }
+    const auto w = static_cast<uint32_t>(index / 32);
+    if (w != word) {
+      flush();
+      word = w;
+      settled_word = __ldg(&propose.settled[w]);
+    }
+    bits |= 1u << (index % 32);
+  }
+
+  __device__ void flush() {
+    const uint32_t fresh = bits & ~settled_word;
+    bits = 0;
+    if (fresh == 0u) return;
+    atomicOr(&propose.free_space[word], fresh);
+    propose.brick_flags[word / (kBrickVoxels / 32)] = 1u;
   }
 };
 
@@ -122,8 +165,10 @@ __global__ void __launch_bounds__(kThreads, 4)
     ray.carve_from_m =
         detail::carving_start(carve_free_space, dense_range_m,
                               carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
-    detail::walk_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, propose,
+    WalkVisitor visit{propose};
+    detail::walk_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, visit,
                      settled_bricks);
+    visit.flush();
   }
 }
 
@@ -141,6 +186,7 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
                                    uint32_t* __restrict__ brick_flags,
                                    uint32_t* __restrict__ candidates, uint32_t* __restrict__ map,
                                    uint32_t* __restrict__ settled,
+                                   uint32_t* __restrict__ free_space,
                                    uint8_t* __restrict__ settled_bricks, int32_t falloff,
                                    uint32_t max_weight, uint32_t* __restrict__ voxels_updated) {
   const uint32_t count = *touched_count;
@@ -151,14 +197,22 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
   for (uint32_t k = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; k < count; k += warps) {
     const uint32_t brick = touched_bricks[k];
     const size_t first = static_cast<size_t>(brick) * kBrickVoxels;
-    // The brick's 16 words of settled bits, word r in lane r.
-    const uint32_t settled_word = lane < kFuseRounds ? settled[first / 32 + lane] : 0u;
+    // The brick's 16 words of settled and of free-space bits, word r in lane r; the
+    // free-space bits are reset for the next scan.
+    const bool word_lane = lane < static_cast<uint32_t>(kFuseRounds);
+    const uint32_t settled_word = word_lane ? settled[first / 32 + lane] : 0u;
+    const uint32_t free_word = word_lane ? free_space[first / 32 + lane] : 0u;
+    if (free_word != 0u) free_space[first / 32 + lane] = 0u;
     uint32_t keys[kFuseRounds];
     uint32_t voxels[kFuseRounds];
 #pragma unroll
     for (int r = 0; r < kFuseRounds; ++r) keys[r] = candidates[first + r * 32 + lane];
+    uint32_t stored = 0;  // bit r: the candidate slot of round r holds a key to reset
 #pragma unroll
     for (int r = 0; r < kFuseRounds; ++r) {
+      if (keys[r] != kEmptyCandidate) stored |= 1u << r;
+      const bool passed_free = ((__shfl_sync(0xffffffffu, free_word, r) >> lane) & 1u) != 0u;
+      if (passed_free && kFreeSpaceKey < keys[r]) keys[r] = kFreeSpaceKey;
       voxels[r] = keys[r] != kEmptyCandidate ? map[first + r * 32 + lane] : 0u;
     }
     bool all_settled = true;
@@ -168,7 +222,7 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
       const bool updated = keys[r] != kEmptyCandidate;
       bool is_settled = ((__shfl_sync(0xffffffffu, settled_word, r) >> lane) & 1u) != 0u;
       if (updated) {
-        candidates[index] = kEmptyCandidate;
+        if (((stored >> r) & 1u) != 0u) candidates[index] = kEmptyCandidate;
         const int32_t value = candidate_value(keys[r]);
         const uint32_t fused =
             pack(fuse(unpack(voxels[r]), value, candidate_weight(value, falloff), max_weight));
@@ -234,6 +288,7 @@ class CudaIntegrator final : public Integrator {
     map_.reserve(n);
     candidates_.reserve(n);
     settled_.reserve(n / 32);
+    free_space_.reserve(n / 32);
     const size_t bricks = n / kBrickVoxels;
     settled_bricks_.reserve(bricks);
     brick_flags_.reserve(bricks);
@@ -244,6 +299,7 @@ class CudaIntegrator final : public Integrator {
         cudaMemsetAsync(brick_flags_.data(), 0, bricks * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(map_.data(), 0, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(settled_.data(), 0, n / 8, stream_));
+    FEATSENSE_CUDA_CHECK(cudaMemsetAsync(free_space_.data(), 0, n / 8, stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(settled_bricks_.data(), 0, bricks, stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(candidates_.data(), 0xFF, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -253,10 +309,11 @@ class CudaIntegrator final : public Integrator {
   std::string backend_name() const override { return "cuda"; }
   const LocalMapGeometry& geometry() const override { return geometry_; }
   size_t memory_bytes() const override {
-    return map_.bytes() + candidates_.bytes() + settled_.bytes() + settled_bricks_.bytes() +
-           brick_flags_.bytes() + touched_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() +
-           origins_.bytes() + counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
-           interpolate_.bytes() + carving_level_.bytes();
+    return map_.bytes() + candidates_.bytes() + settled_.bytes() + free_space_.bytes() +
+           settled_bricks_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
+           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
+           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes() +
+           carving_level_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -331,7 +388,7 @@ class CudaIntegrator final : public Integrator {
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
     const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
-                                   settled_.data()};
+                                   settled_.data(), free_space_.data()};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
@@ -345,8 +402,8 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
-        settled_.data(), settled_bricks_.data(), settings_.falloff_start_fixed(),
-        settings_.max_weight_fixed(), updated_count);
+        settled_.data(), free_space_.data(), settled_bricks_.data(),
+        settings_.falloff_start_fixed(), settings_.max_weight_fixed(), updated_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
                                          kCounters * sizeof(uint32_t), cudaMemcpyDeviceToHost,
@@ -419,6 +476,7 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<uint32_t> map_;
   cuda::DeviceBuffer<uint32_t> candidates_;
   cuda::DeviceBuffer<uint32_t> settled_;         ///< a bit per voxel of settled free space
+  cuda::DeviceBuffer<uint32_t> free_space_;      ///< a bit per voxel passed in free space
   cuda::DeviceBuffer<uint8_t> settled_bricks_;   ///< 1 per brick of settled free space only
   cuda::DeviceBuffer<uint32_t> brick_flags_;     ///< 1 while a brick is in touched_bricks_
   cuda::DeviceBuffer<uint32_t> touched_bricks_;  ///< bricks with a candidate this scan
