@@ -64,9 +64,6 @@ __device__ void write_warp_bits(uint32_t* bits, size_t index, bool bit) {
   if (threadIdx.x % 32u == 0u) bits[index / 32] = word;
 }
 
-/// The key of free space: +tau, measured. Every free-space visit proposes exactly it.
-constexpr uint32_t kFreeSpaceKey = static_cast<uint32_t>(kValueScale) << 16;
-
 struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;

@@ -51,6 +51,7 @@ class CpuIntegrator final : public Integrator {
         brick_owner_(geometry_.voxel_count() / kBrickVoxels, 0),
         brick_listed_(geometry_.voxel_count() / kBrickVoxels, 0),
         occupancy_(geometry_.voxel_count() / 64, 0),
+        free_space_(geometry_.voxel_count() / 64, 0),
         settled_(geometry_.voxel_count() / 64, 0),
         settled_bricks_(geometry_.voxel_count() / kBrickVoxels, 0),
         settled_voxel_(settled_free_voxel(settings.max_weight_fixed())),
@@ -65,7 +66,7 @@ class CpuIntegrator final : public Integrator {
   const LocalMapGeometry& geometry() const override { return geometry_; }
   std::vector<uint32_t> download() const override { return map_; }
   size_t memory_bytes() const override {
-    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + 2 * geometry_.voxel_count() / 8 +
+    return geometry_.voxel_count() * 2 * sizeof(uint32_t) + 3 * geometry_.voxel_count() / 8 +
            3 * geometry_.voxel_count() / kBrickVoxels;
   }
 
@@ -230,16 +231,23 @@ class CpuIntegrator final : public Integrator {
   size_t fuse_brick(size_t brick, int32_t falloff, uint32_t max_weight) {
     size_t updated = 0;
     for (size_t word = brick * kWordsPerBrick; word < (brick + 1) * kWordsPerBrick; ++word) {
-      uint64_t bits = occupancy_[word];
+      const uint64_t with_key = occupancy_[word];
+      const uint64_t passed_free = free_space_[word];
       occupancy_[word] = 0;
-      for (; bits != 0; bits &= bits - 1) {
+      free_space_[word] = 0;
+      for (uint64_t bits = with_key | passed_free; bits != 0; bits &= bits - 1) {
+        const uint64_t bit = bits & (~bits + 1);
         const size_t index = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
-        const int32_t value = candidate_value(candidates_[index].load(std::memory_order_relaxed));
-        candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
+        uint32_t key = kEmptyCandidate;
+        if ((with_key & bit) != 0) {
+          key = candidates_[index].load(std::memory_order_relaxed);
+          candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
+        }
+        if ((passed_free & bit) != 0 && kFreeSpaceKey < key) key = kFreeSpaceKey;
+        const int32_t value = candidate_value(key);
         const uint32_t fused = pack(
             fuse_voxel(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
         map_[index] = fused;
-        const uint64_t bit = uint64_t{1} << (index % 64);
         settled_[word] = fused == settled_voxel_ ? settled_[word] | bit : settled_[word] & ~bit;
         ++updated;
       }
@@ -321,12 +329,16 @@ class CpuIntegrator final : public Integrator {
           ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) {
         return;
       }
+      const uint8_t owner = brick_owner_[index / kBrickVoxels];
+      if (value == kValueScale && !interpolated && owner == p) {
+        pass_free_space(part, index);
+        return;
+      }
       const uint32_t key = make_candidate(value, interpolated);
       // Candidates only fall during a scan: one at or below this key already makes it moot.
       // (Near the sensor, where every ray passes, that is nearly every visit.)
       const uint32_t current = candidates_[index].load(std::memory_order_relaxed);
       if (key >= current) return;
-      const uint8_t owner = brick_owner_[index / kBrickVoxels];
       if (owner == p) {
         lower(part, index, key, current);
       } else {
@@ -354,17 +366,33 @@ class CpuIntegrator final : public Integrator {
     }
   }
 
+  /// Free space passed in a voxel of `part`'s sector: every such visit proposes the same key
+  /// (+tau, measured), so a bit per voxel says it all, and the fusion takes min(candidate, +tau)
+  /// where it is set. Bits are a cache line a brick; a candidate load was a cache line a few
+  /// voxels, at almost every step of a walk.
+  void pass_free_space(Part& part, size_t index) {
+    uint64_t& word = free_space_[index / 64];
+    const uint64_t bit = uint64_t{1} << (index % 64);
+    if ((word & bit) != 0) return;
+    word |= bit;
+    list_brick(part, index / kBrickVoxels);
+  }
+
+  /// Lists a brick for the fusion once.
+  void list_brick(Part& part, size_t brick) {
+    if (brick_listed_[brick] == 0) {
+      brick_listed_[brick] = 1;
+      part.touched.push_back(static_cast<uint32_t>(brick));
+    }
+  }
+
   /// Writes a smaller candidate to a voxel of `part`'s sector; the brick of a voxel's first
   /// candidate is listed once, for the fusion.
   void lower(Part& part, size_t index, uint32_t key, uint32_t current) {
     candidates_[index].store(key, std::memory_order_relaxed);
     if (current != kEmptyCandidate) return;
     occupancy_[index / 64] |= uint64_t{1} << (index % 64);
-    const size_t brick = index / kBrickVoxels;
-    if (brick_listed_[brick] == 0) {
-      brick_listed_[brick] = 1;
-      part.touched.push_back(static_cast<uint32_t>(brick));
-    }
+    list_brick(part, index / kBrickVoxels);
   }
 
   TsdfSettings settings_;
@@ -376,6 +404,7 @@ class CpuIntegrator final : public Integrator {
   std::vector<uint8_t> brick_owner_;     ///< the sector that writes each brick, this scan
   std::vector<uint8_t> brick_listed_;    ///< 1 while a brick is listed for the fusion
   std::vector<uint64_t> occupancy_;      ///< a bit per voxel that has a candidate
+  std::vector<uint64_t> free_space_;     ///< a bit per voxel passed in free space this scan
   std::vector<uint64_t> settled_;        ///< a bit per voxel of settled free space
   std::vector<uint8_t> settled_bricks_;  ///< 1 per brick of settled free space only
   uint32_t settled_voxel_;               ///< what such a voxel holds

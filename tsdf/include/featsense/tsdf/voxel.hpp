@@ -71,6 +71,9 @@ FEATSENSE_HD_INLINE uint32_t make_candidate(int32_t value, bool interpolated) {
   return (interpolated ? 0x80000000u : 0u) | (magnitude << 16) | (value < 0 ? 0x8000u : 0u);
 }
 
+/// The key of free space (+tau, measured), which every visit in front of the band proposes.
+constexpr uint32_t kFreeSpaceKey = static_cast<uint32_t>(kValueScale) << 16;
+
 FEATSENSE_HD_INLINE int32_t candidate_value(uint32_t key) {
   const int32_t magnitude = static_cast<int32_t>((key >> 16) & 0x7FFFu);
   return (key & 0x8000u) != 0u ? -magnitude : magnitude;
