@@ -173,11 +173,11 @@ __global__ void __launch_bounds__(kThreads, 4)
 /// voxel 32 r + l of round r.
 constexpr int kFuseRounds = kBrickVoxels / 32;
 
-/// One warp per touched brick: fuses the candidates into the map, resets them and the brick's
-/// flag for the next scan, and renews the brick's settled bits and flag. Each lane first loads
-/// all its 16 keys, then the map voxels of those that got one, so that a warp has up to 32
-/// loads in flight: with one voxel a thread and a barrier per brick, the fusion waited for
-/// memory brick by brick (a quarter of an outdoor scan's time).
+/// One warp per touched brick: fuses the candidates, and +tau where a free-space bit is set,
+/// into the map, resets them and the brick's flag for the next scan, and renews the brick's settled
+/// bits and flag. Each lane first loads all its 16 keys, then the map voxels of those that got one,
+/// so that a warp has up to 32 loads in flight: with one voxel a thread and a barrier per brick,
+/// the fusion waited for memory brick by brick (a quarter of an outdoor scan's time).
 __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
                                    const uint32_t* __restrict__ touched_count,
                                    uint32_t* __restrict__ brick_flags,

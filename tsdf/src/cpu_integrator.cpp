@@ -225,9 +225,10 @@ class CpuIntegrator final : public Integrator {
     return updated.load();
   }
 
-  /// Fuses the candidates of one brick, visiting only the voxels its occupancy bits name
+  /// Fuses the candidates of one brick, and +tau where its free-space bits are set (the
+  /// smaller key wins), visiting only the voxels its occupancy and free-space bits name
   /// (testing every voxel for a candidate mispredicts a branch on most partly touched
-  /// bricks); resets them and returns how many there were.
+  /// bricks); resets them and returns how many voxels there were.
   size_t fuse_brick(size_t brick, int32_t falloff, uint32_t max_weight) {
     size_t updated = 0;
     for (size_t word = brick * kWordsPerBrick; word < (brick + 1) * kWordsPerBrick; ++word) {
