@@ -56,12 +56,13 @@ __global__ void select_rays_kernel(const Vec3* endpoints, uint32_t n, LocalMapGe
   if (keep) kept[atomicAdd(kept_count, 1u)] = i;
 }
 
-/// Settled bits are a bit set of 32-bit words: a warp's 32 consecutive voxels are a word.
-/// Sets each lane's voxel bit in the warp's word. The whole warp calls it, on 32 consecutive
-/// voxels starting at a multiple of 32.
-__device__ void write_warp_bits(uint32_t* bits, size_t index, bool bit) {
-  const unsigned int word = __ballot_sync(0xffffffffu, bit);
+/// Sets each lane's voxel bit in a bit set of 32-bit words (the settled bits), where a warp's
+/// 32 consecutive voxels are a word, and returns the word. The whole warp calls it, on 32
+/// consecutive voxels starting at a multiple of 32.
+__device__ uint32_t write_warp_bits(uint32_t* bits, size_t index, bool bit) {
+  const uint32_t word = __ballot_sync(0xffffffffu, bit);
   if (threadIdx.x % 32u == 0u) bits[index / 32] = word;
+  return word;
 }
 
 struct ProposeCandidate {
@@ -226,12 +227,9 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
         map[index] = fused;
         is_settled = fused == settled_voxel;
       }
-      const uint32_t word = __ballot_sync(0xffffffffu, is_settled);
+      const uint32_t word = write_warp_bits(settled, index, is_settled);
       const uint32_t updated_lanes = __ballot_sync(0xffffffffu, updated);
-      if (lane == 0u) {
-        settled[first / 32 + r] = word;
-        updated_here += static_cast<uint32_t>(__popc(updated_lanes));
-      }
+      if (lane == 0u) updated_here += static_cast<uint32_t>(__popc(updated_lanes));
       all_settled = all_settled && word == 0xffffffffu;
     }
     if (lane == 0u) {

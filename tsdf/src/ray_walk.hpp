@@ -23,6 +23,75 @@
 
 namespace featsense::tsdf::detail {
 
+/// Along one axis, a step of `step` (+-1) that left the brick: the place in the brick moves to
+/// the near side of the next brick, whose ring-buffer slot wraps around `bricks` slots.
+FEATSENSE_HD_INLINE void enter_next_brick(int32_t& local, int32_t& brick, int32_t step,
+                                          int32_t bricks) {
+  local -= step * kBrickSize;
+  brick += step;
+  if (brick == bricks) brick = 0;
+  if (brick < 0) brick = bricks - 1;
+}
+
+/// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
+struct BrickExit {
+  int axis;            ///< the axis whose crossing leaves the brick
+  float t;             ///< the walk's t at that crossing
+  int32_t crossed[3];  ///< face crossings per axis up to and including it
+  float t_next[3];     ///< the next crossing per axis after them
+};
+
+/// The exit of the walk from its current brick (`local`: its place in the brick), computed
+/// without stepping through the voxels: crossings of voxel faces come in the order of their
+/// t, the lower axis first on ties (the rule of the walk's step), and each axis's crossings are
+/// the same running sums t_next += t_delta, so the state is exactly the one that stepping voxel
+/// by voxel reaches. A brick all of whose voxels would pass every candidate by can so be
+/// crossed in one jump. False where the walk ends (t > walk_length) before the exit.
+FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
+                                    const float t_next[3], const float t_delta[3],
+                                    float walk_length, BrickExit& exit) {
+  // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
+  int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
+  exit.axis = -1;
+  exit.t = 0.0f;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (step[axis] == 0) continue;
+    to_leave[axis] = step[axis] > 0 ? kBrickSize - local[axis] : local[axis] + 1;
+    float tn = t_next[axis];
+    for (int32_t k = 1; k < to_leave[axis]; ++k) tn += t_delta[axis];
+    if (exit.axis < 0 || tn < exit.t) {
+      exit.axis = axis;
+      exit.t = tn;
+    }
+  }
+  if (exit.axis < 0) return false;
+  if (!(exit.t <= walk_length)) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    int32_t crossed = 0;
+    float tn = t_next[axis];
+    if (axis == exit.axis) {
+      crossed = to_leave[axis];
+      tn = exit.t + t_delta[axis];
+    } else if (step[axis] != 0) {
+      while (tn < exit.t || (tn == exit.t && axis < exit.axis)) {
+        tn += t_delta[axis];
+        ++crossed;
+      }
+    }
+    exit.crossed[axis] = crossed;
+    exit.t_next[axis] = tn;
+  }
+  return true;
+}
+
+/// The walk's t from which every voxel it enters is free space: a voxel's centre lies within
+/// 0.87 voxels of the ray where the ray crosses it, so from here on its distance to the end
+/// point is at least tau. t1: the ray parameter where the walk starts.
+FEATSENSE_HD_INLINE float free_space_from(float t1, float range, float truncation_m,
+                                          float voxel_size_m) {
+  return truncation_m + voxel_size_m + t1 - range;
+}
+
 /// Calls visit(linear_index, value_fixed, interpolated) for every candidate march_ray would
 /// propose for this ray, in the same order, except the free-space candidates of the bricks
 /// that `settled_bricks` (nonzero per brick slot, or null) names as settled free space.
