@@ -69,6 +69,7 @@ struct ProposeCandidate {
   LocalMapGeometry map;
   uint32_t* candidates;
   uint32_t* brick_flags;
+  uint32_t* band_bricks;  ///< 1 per brick with a candidate this scan (not free space alone)
   const uint32_t* settled;
   uint32_t* free_space;  ///< a bit per voxel that a ray passed in free space this scan
 
@@ -87,7 +88,10 @@ struct ProposeCandidate {
     atomicMin(&candidates[index], key);
     // Mark the brick for the fusion. The thread whose minimum lands first on an empty voxel
     // read it empty (nothing had landed before), so every touched brick gets marked.
-    if (current == kEmptyCandidate) brick_flags[index / kBrickVoxels] = 1u;
+    if (current == kEmptyCandidate) {
+      brick_flags[index / kBrickVoxels] = 1u;
+      band_bricks[index / kBrickVoxels] = 1u;
+    }
   }
 };
 
@@ -179,14 +183,12 @@ constexpr int kFuseRounds = kBrickVoxels / 32;
 /// bits and flag. Each lane first loads all its 16 keys, then the map voxels of those that got one,
 /// so that a warp has up to 32 loads in flight: with one voxel a thread and a barrier per brick,
 /// the fusion waited for memory brick by brick (a quarter of an outdoor scan's time).
-__global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
-                                   const uint32_t* __restrict__ touched_count,
-                                   uint32_t* __restrict__ brick_flags,
-                                   uint32_t* __restrict__ candidates, uint32_t* __restrict__ map,
-                                   uint32_t* __restrict__ settled,
-                                   uint32_t* __restrict__ free_space,
-                                   uint8_t* __restrict__ settled_bricks, int32_t falloff,
-                                   uint32_t max_weight, uint32_t* __restrict__ voxels_updated) {
+__global__ void fuse_bricks_kernel(
+    const uint32_t* __restrict__ touched_bricks, const uint32_t* __restrict__ touched_count,
+    uint32_t* __restrict__ brick_flags, uint32_t* __restrict__ band_bricks,
+    uint32_t* __restrict__ candidates, uint32_t* __restrict__ map, uint32_t* __restrict__ settled,
+    uint32_t* __restrict__ free_space, uint8_t* __restrict__ settled_bricks, int32_t falloff,
+    uint32_t max_weight, uint32_t* __restrict__ voxels_updated) {
   const uint32_t count = *touched_count;
   const uint32_t settled_voxel = settled_free_voxel(max_weight);
   const uint32_t lane = threadIdx.x % 32u;
@@ -201,10 +203,15 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
     const uint32_t settled_word = word_lane ? settled[first / 32 + lane] : 0u;
     const uint32_t free_word = word_lane ? free_space[first / 32 + lane] : 0u;
     if (free_word != 0u) free_space[first / 32 + lane] = 0u;
+    // Most touched bricks were only passed in free space (no candidate): their keys are not
+    // read at all.
+    const bool with_keys = band_bricks[brick] != 0u;
     uint32_t keys[kFuseRounds];
     uint32_t voxels[kFuseRounds];
 #pragma unroll
-    for (int r = 0; r < kFuseRounds; ++r) keys[r] = candidates[first + r * 32 + lane];
+    for (int r = 0; r < kFuseRounds; ++r) {
+      keys[r] = with_keys ? candidates[first + r * 32 + lane] : kEmptyCandidate;
+    }
     uint32_t stored = 0;  // bit r: the candidate slot of round r holds a key to reset
 #pragma unroll
     for (int r = 0; r < kFuseRounds; ++r) {
@@ -234,6 +241,7 @@ __global__ void fuse_bricks_kernel(const uint32_t* __restrict__ touched_bricks,
     }
     if (lane == 0u) {
       brick_flags[brick] = 0u;
+      if (with_keys) band_bricks[brick] = 0u;
       settled_bricks[brick] = all_settled ? 1u : 0u;
     }
   }
@@ -287,11 +295,14 @@ class CudaIntegrator final : public Integrator {
     const size_t bricks = n / kBrickVoxels;
     settled_bricks_.reserve(bricks);
     brick_flags_.reserve(bricks);
+    band_bricks_.reserve(bricks);
     touched_bricks_.reserve(bricks);
     counters_.reserve(kCounters);
     host_counters_.reserve(kCounters);
     FEATSENSE_CUDA_CHECK(
         cudaMemsetAsync(brick_flags_.data(), 0, bricks * sizeof(uint32_t), stream_));
+    FEATSENSE_CUDA_CHECK(
+        cudaMemsetAsync(band_bricks_.data(), 0, bricks * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(map_.data(), 0, n * sizeof(uint32_t), stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(settled_.data(), 0, n / 8, stream_));
     FEATSENSE_CUDA_CHECK(cudaMemsetAsync(free_space_.data(), 0, n / 8, stream_));
@@ -305,10 +316,10 @@ class CudaIntegrator final : public Integrator {
   const LocalMapGeometry& geometry() const override { return geometry_; }
   size_t memory_bytes() const override {
     return map_.bytes() + candidates_.bytes() + settled_.bytes() + free_space_.bytes() +
-           settled_bricks_.bytes() + brick_flags_.bytes() + touched_bricks_.bytes() +
-           kept_.bytes() + endpoints_.bytes() + origins_.bytes() + counters_.bytes() +
-           brick_offsets_.bytes() + brick_staging_.bytes() + interpolate_.bytes() +
-           carving_level_.bytes();
+           settled_bricks_.bytes() + brick_flags_.bytes() + band_bricks_.bytes() +
+           touched_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() + origins_.bytes() +
+           counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
+           interpolate_.bytes() + carving_level_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -382,8 +393,8 @@ class CudaIntegrator final : public Integrator {
     params.truncation_m = settings_.truncation_m;
     params.interpolation_slope = settings_.interpolation_slope;
     params.up = rays.up;
-    const ProposeCandidate propose{geometry_, candidates_.data(), brick_flags_.data(),
-                                   settled_.data(), free_space_.data()};
+    const ProposeCandidate propose{geometry_,           candidates_.data(), brick_flags_.data(),
+                                   band_bricks_.data(), settled_.data(),    free_space_.data()};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
@@ -396,9 +407,10 @@ class CudaIntegrator final : public Integrator {
         brick_flags_.data(), brick_count, touched_bricks_.data(), touched_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
-        touched_bricks_.data(), touched_count, brick_flags_.data(), candidates_.data(), map_.data(),
-        settled_.data(), free_space_.data(), settled_bricks_.data(),
-        settings_.falloff_start_fixed(), settings_.max_weight_fixed(), updated_count);
+        touched_bricks_.data(), touched_count, brick_flags_.data(), band_bricks_.data(),
+        candidates_.data(), map_.data(), settled_.data(), free_space_.data(),
+        settled_bricks_.data(), settings_.falloff_start_fixed(), settings_.max_weight_fixed(),
+        updated_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
                                          kCounters * sizeof(uint32_t), cudaMemcpyDeviceToHost,
@@ -474,6 +486,7 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<uint32_t> free_space_;      ///< a bit per voxel passed in free space
   cuda::DeviceBuffer<uint8_t> settled_bricks_;   ///< 1 per brick of settled free space only
   cuda::DeviceBuffer<uint32_t> brick_flags_;     ///< 1 while a brick is in touched_bricks_
+  cuda::DeviceBuffer<uint32_t> band_bricks_;     ///< 1 per brick of those with a candidate
   cuda::DeviceBuffer<uint32_t> touched_bricks_;  ///< bricks with a candidate this scan
   unsigned int resident_blocks_ = 1;
   cuda::DeviceBuffer<uint32_t> kept_;

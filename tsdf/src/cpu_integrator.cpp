@@ -30,17 +30,6 @@ uint32_t atomic_min(std::atomic<uint32_t>& slot, uint32_t value) {
   return current;
 }
 
-/// tsdf::fuse, without its division where the result is known: a voxel never observed, or
-/// one that already holds the scan's value (most of the carved free space), keeps the value.
-Voxel fuse_voxel(Voxel map, int32_t value, uint32_t weight, uint32_t max_weight_fixed) {
-  if (weight != 0u && (map.weight == 0u || map.value == value)) {
-    const uint32_t total = map.weight + weight;
-    return {static_cast<int16_t>(value),
-            static_cast<uint16_t>(total < max_weight_fixed ? total : max_weight_fixed)};
-  }
-  return fuse(map, value, weight, max_weight_fixed);
-}
-
 class CpuIntegrator final : public Integrator {
  public:
   CpuIntegrator(const TsdfSettings& settings, Vec3 centre_m)
@@ -247,7 +236,7 @@ class CpuIntegrator final : public Integrator {
         if ((passed_free & bit) != 0 && kFreeSpaceKey < key) key = kFreeSpaceKey;
         const int32_t value = candidate_value(key);
         const uint32_t fused = pack(
-            fuse_voxel(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
+            tsdf::fuse(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
         map_[index] = fused;
         settled_[word] = fused == settled_voxel_ ? settled_[word] | bit : settled_[word] & ~bit;
         ++updated;
@@ -324,7 +313,8 @@ class CpuIntegrator final : public Integrator {
   void march_sector(size_t p, const RayBatch& rays, const std::vector<uint32_t>& ray_ids,
                     const detail::RayMarchParams& params) {
     Part& part = parts_[p];
-    const auto propose = [&](size_t index, int32_t value, bool interpolated) {
+    const auto propose = [&](size_t index, int32_t value, bool interpolated)
+        __attribute__((always_inline)) {
       // Settled free space stays as it is (the bits are a cache line a brick, mostly cached).
       if (passes_settled_by(value, interpolated) &&
           ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) {

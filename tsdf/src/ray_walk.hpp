@@ -6,9 +6,10 @@
 // bit the same (test_cpu_integrator_exact checks it against march_ray itself); only
 // bookkeeping is cheaper:
 // - the storage index and the map-bounds test follow the traversal incrementally instead of
-//   being recomputed from the global index at every voxel;
+//   being recomputed from the global index at every voxel, across brick faces too;
 // - of the projective distance, only the term of the axis just stepped is recomputed (each
-//   term is the same product as in march_ray, and the sum is formed in the same order);
+//   term is the same product as in march_ray, and the sum is formed in the same order), and
+//   none from where the rest of the walk is free space (free_space_from);
 // - free space (d >= tau) needs no division: d / tau >= 1 there, so the clamped value is
 //   exactly kValueScale, and there is no interpolation;
 // - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
@@ -124,8 +125,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   int32_t step[3] = {};
   float t_next[3] = {};
   float t_delta[3] = {};
-  int32_t voxel[3] = {};   // global index
-  int32_t offset[3] = {};  // index relative to the map's lowest corner: inside when in [0, dim)
+  int32_t offset[3] = {};  // global index less the map's lowest corner: inside when in [0, dim)
   int32_t dim[3] = {};     // voxels per axis
   int32_t brick[3] = {};   // ring-buffer slot coordinates of the current brick
   int32_t local[3] = {};   // place in the brick
@@ -150,7 +150,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       t_next[axis] = FLT_MAX;
       t_delta[axis] = FLT_MAX;
     }
-    voxel[axis] = v;
     offset[axis] = v - component(map.origin, axis);
     dim[axis] = component(map.dim, axis);
     brick[axis] = component(start_brick, axis);
@@ -167,6 +166,14 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   // Storage strides of one step inside a brick, per axis.
   const int64_t local_stride[3] = {1, kBrickSize, kBrickSize * kBrickSize};
   int64_t index = static_cast<int64_t>(linear());
+  // Storage distance between neighbouring brick slots along an axis, and the ring buffer's
+  // length along it (a slot that wraps around moves that much back, or on). Computed where
+  // needed, from registers the walk holds anyway.
+  const auto slot_stride = [&](auto axis_constant) -> int64_t {
+    constexpr int axis = decltype(axis_constant)::value;
+    return static_cast<int64_t>(kBrickVoxels) * (axis > 0 ? bricks[0] : 1) *
+           (axis > 1 ? bricks[1] : 1);
+  };
 
   // map.linear for a voxel known to lie in the map, without its three divisions: the brick's
   // offset from the map's lowest brick is below the brick count, so wrapping it is one
@@ -195,10 +202,9 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     for (int axis = 0; axis < 3; ++axis) {
       const int32_t moved = step[axis] * exit.crossed[axis];
       t_next[axis] = exit.t_next[axis];
-      voxel[axis] += moved;
       offset[axis] += moved;
       local[axis] += moved;
-      term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
+      // (The terms are not needed any more: a jump is made in free space only.)
     }
     t = exit.t;
     for (int axis = 0; axis < 3; ++axis) {  // constant indices keep the arrays in registers
@@ -208,72 +214,114 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
   };
 
-  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
   bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
+  // A step along `axis` if `taken` (every axis is passed through, so that on the GPU the
+  // untaken ones are selects, not branches). Crossing a brick face moves the storage index
+  // to the neighbouring brick slot by constants, wrapping around the ring buffer.
+  const auto advance = [&](bool taken, auto axis_constant, bool in_free_space) {
+    constexpr int axis = decltype(axis_constant)::value;
+    const int32_t s = taken ? step[axis] : 0;
+    if (taken) t = t_next[axis];
+    t_next[axis] = taken ? t_next[axis] + t_delta[axis] : t_next[axis];
+    offset[axis] += s;
+    local[axis] += s;
+    index += s * local_stride[axis];
+    // Terms are only needed before free space starts (and t only grows).
+    if (taken && !in_free_space) {
+      term[axis] = ((static_cast<float>(offset[axis] + component(map.origin, axis)) + 0.5f) * vs -
+                    origin_c[axis]) *
+                   dir_c[axis];
+    }
+    if (static_cast<uint32_t>(local[axis]) >= static_cast<uint32_t>(kBrickSize)) {
+      // To the same place in the neighbouring brick slot.
+      const int64_t stride = slot_stride(axis_constant);
+      local[axis] -= s * kBrickSize;
+      brick[axis] += s;
+      index += s * (stride - kBrickSize * local_stride[axis]);
+      if (brick[axis] == bricks[axis]) {
+        brick[axis] = 0;
+        index -= bricks[axis] * stride;
+      } else if (brick[axis] < 0) {
+        brick[axis] = bricks[axis] - 1;
+        index += bricks[axis] * stride;
+      }
+      new_brick = settled_bricks != nullptr;
+    }
+  };
+
+  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
   for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
     const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
                         static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
                         static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
+    // From free_from on, every voxel is free space (free_space_from): march_ray's distance
+    // there is always >= tau, so it is not computed, nor the terms it is made of.
+    const bool in_free_space = t >= free_from;
+    bool jump = false;
     if (new_brick) {
       new_brick = false;
       // A brick inside the map lies wholly inside it (the map is whole bricks).
-      if (inside && t >= free_from && settled_bricks[index / kBrickVoxels] != 0) {
-        const int32_t taken = leave_brick();
-        if (taken < 0 || i + taken >= max_steps) return;
-        i += taken - 1;  // the loop adds the last one
-        new_brick = true;
-        continue;
-      }
+      jump = inside && in_free_space && settled_bricks[index / kBrickVoxels] != 0;
     }
-    if (inside) {
-      const float along = (term[0] + term[1]) + term[2];
-      const float distance = range - along;
-      if (distance >= tau) {
-        visit(static_cast<size_t>(index), kValueScale, false);
-      } else if (distance >= -tau) {
-        const int32_t value = distance_to_fixed(distance, tau);
-        visit(static_cast<size_t>(index), value, false);
-        if (interpolate) {
-          const Index3 g{voxel[0], voxel[1], voxel[2]};
-          const Vec3 centre = map.centre_of(g);
-          const float half_height = params.interpolation_slope * along;
-          const int32_t reach = static_cast<int32_t>(half_height / vs);
-          for (int32_t k = 1; k <= reach; ++k) {
-            const float shift = static_cast<float>(k) * vs;
-            const Index3 above = map.voxel_of(centre + shift * across);
-            const Index3 below = map.voxel_of(centre - shift * across);
-            if (map.contains(above)) visit(linear_of_contained(above), value, true);
-            if (map.contains(below)) visit(linear_of_contained(below), value, true);
+    // One if-else per turn, no early turn back to the loop's head: on the GPU, the lanes of a
+    // warp then meet again at the end of every turn.
+    if (jump) {
+      const int32_t taken = leave_brick();
+      if (taken < 0 || i + taken >= max_steps) break;
+      i += taken - 1;  // the loop adds the last one
+      new_brick = true;
+    } else {
+      if (inside) {
+        if (in_free_space) {
+          visit(static_cast<size_t>(index), kValueScale, false);
+        } else {
+          const float along = (term[0] + term[1]) + term[2];
+          const float distance = range - along;
+          if (distance >= tau) {
+            visit(static_cast<size_t>(index), kValueScale, false);
+          } else if (distance >= -tau) {
+            const int32_t value = distance_to_fixed(distance, tau);
+            visit(static_cast<size_t>(index), value, false);
+            if (interpolate) {
+              const Index3 g{offset[0] + map.origin.x, offset[1] + map.origin.y,
+                             offset[2] + map.origin.z};
+              const Vec3 centre = map.centre_of(g);
+              const float half_height = params.interpolation_slope * along;
+              const int32_t reach = static_cast<int32_t>(half_height / vs);
+              for (int32_t k = 1; k <= reach; ++k) {
+                const float shift = static_cast<float>(k) * vs;
+                const Index3 above = map.voxel_of(centre + shift * across);
+                const Index3 below = map.voxel_of(centre - shift * across);
+                if (map.contains(above)) visit(linear_of_contained(above), value, true);
+                if (map.contains(below)) visit(linear_of_contained(below), value, true);
+              }
+            }
           }
         }
       }
-    }
-    // Step into the neighbour across the nearest voxel face (march_ray's rule). Each axis has
-    // its own code, so that every array above is indexed by a constant and lives in registers.
-    const auto step_along = [&](auto axis_constant) {
-      constexpr int axis = decltype(axis_constant)::value;
-      t = t_next[axis];
-      t_next[axis] += t_delta[axis];
-      const int32_t s = step[axis];
-      voxel[axis] += s;
-      offset[axis] += s;
-      term[axis] = ((static_cast<float>(voxel[axis]) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
-      local[axis] += s;
-      if (local[axis] == kBrickSize || local[axis] < 0) {
-        enter_next_brick(local[axis], brick[axis], s, bricks[axis]);
-        index = static_cast<int64_t>(linear());
-        new_brick = settled_bricks != nullptr;
+      // Step into the neighbour across the nearest voxel face (march_ray's rule). Which axis
+      // comes next follows no pattern: the CPU branches (the prediction lets the next steps
+      // start early; a miss costs less than computing all three), the GPU computes all three
+      // axes with selects (branches would split a warp three ways). Every array is indexed
+      // by a constant, so the traversal state stays in registers.
+      const bool y_first = t_next[1] < t_next[0];
+      const bool along_z = t_next[2] < (y_first ? t_next[1] : t_next[0]);
+      constexpr std::integral_constant<int, 0> x;
+      constexpr std::integral_constant<int, 1> y;
+      constexpr std::integral_constant<int, 2> z;
+#ifdef __CUDA_ARCH__
+      advance(!along_z && !y_first, x, in_free_space);
+      advance(!along_z && y_first, y, in_free_space);
+      advance(along_z, z, in_free_space);
+#else
+      if (along_z) {
+        advance(true, z, in_free_space);
+      } else if (y_first) {
+        advance(true, y, in_free_space);
       } else {
-        index += s * local_stride[axis];
+        advance(true, x, in_free_space);
       }
-    };
-    const bool y_first = t_next[1] < t_next[0];
-    if (t_next[2] < (y_first ? t_next[1] : t_next[0])) {
-      step_along(std::integral_constant<int, 2>());
-    } else if (y_first) {
-      step_along(std::integral_constant<int, 1>());
-    } else {
-      step_along(std::integral_constant<int, 0>());
+#endif
     }
   }
 }

@@ -103,11 +103,17 @@ FEATSENSE_HD_INLINE Voxel fuse(Voxel map, int32_t value, uint32_t weight,
                                uint32_t max_weight_fixed) {
   if (weight == 0u) return map;
   const int64_t total = static_cast<int64_t>(map.weight) + weight;
+  Voxel out;
+  out.weight = static_cast<uint16_t>(total < max_weight_fixed ? total : max_weight_fixed);
+  // The average of a value with itself, or with nothing, is that value: no division there
+  // (most of the carved free space; a 64-bit division is a long routine on a GPU).
+  if (map.weight == 0u || map.value == value) {
+    out.value = static_cast<int16_t>(value);
+    return out;
+  }
   const int64_t numerator =
       static_cast<int64_t>(map.value) * map.weight + static_cast<int64_t>(value) * weight;
-  Voxel out;
   out.value = static_cast<int16_t>(divide_rounded(numerator, total));
-  out.weight = static_cast<uint16_t>(total < max_weight_fixed ? total : max_weight_fixed);
   return out;
 }
 
