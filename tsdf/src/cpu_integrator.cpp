@@ -48,7 +48,10 @@ class CpuIntegrator final : public Integrator {
     for (size_t i = 0; i < geometry_.voxel_count(); ++i) {
       candidates_[i].store(kEmptyCandidate, std::memory_order_relaxed);
     }
-    for (Part& part : parts_) part.handed_over.resize(parts_.size());
+    for (Part& part : parts_) {
+      part.handed_over.resize(parts_.size());
+      part.free_handed_over.resize(parts_.size());
+    }
   }
 
   std::string backend_name() const override { return "cpu"; }
@@ -110,6 +113,7 @@ class CpuIntegrator final : public Integrator {
     for (Part& part : parts_) {
       part.touched.clear();
       for (auto& list : part.handed_over) list.clear();
+      for (auto& list : part.free_handed_over) list.clear();
     }
     tbb::parallel_for(
         size_t{0}, parts_.size(), [&](size_t p) { march_sector(p, rays, rays_of[p], params); },
@@ -144,10 +148,16 @@ class CpuIntegrator final : public Integrator {
     size_t index;
     uint32_t key;
   };
+  /// Free space passed in a 64-voxel word of another sector.
+  struct FreeBits {
+    size_t word;
+    uint64_t bits;
+  };
   /// What one sector's task collects while walking its rays.
   struct Part {
-    std::vector<uint32_t> touched;                     ///< bricks listed for the fusion
-    std::vector<std::vector<HandedOver>> handed_over;  ///< by owning sector
+    std::vector<uint32_t> touched;                        ///< bricks listed for the fusion
+    std::vector<std::vector<HandedOver>> handed_over;     ///< by owning sector
+    std::vector<std::vector<FreeBits>> free_handed_over;  ///< by owning sector
   };
 
   /// Indices of the rays to march: all, or the first end point of each voxel of the local
@@ -309,42 +319,77 @@ class CpuIntegrator final : public Integrator {
     return rays_of;
   }
 
+  /// A walk's visitor for sector p. Free space, most of every walk, proposes the same key at
+  /// every visit (+tau, measured), so the scan's minimum only needs to know which voxels were
+  /// passed: their bits are gathered in a register while the walk stays in one 64-voxel word
+  /// (8 x 8 voxels of a brick) and then set in free_space_ at once (or handed over), settled
+  /// free space left out. A free-space step so touches no memory; the fusion takes
+  /// min(candidate, +tau) where a bit is set, as if each visit had proposed +tau.
+  struct SectorVisitor {
+    CpuIntegrator& self;
+    size_t p;
+    size_t word = std::numeric_limits<size_t>::max();  // the word being gathered, none yet
+    uint64_t bits = 0;
+
+    void operator()(size_t index, int32_t value, bool interpolated) {
+      if (value == kValueScale && !interpolated) {
+        if (index / 64 != word) {
+          flush();
+          word = index / 64;
+        }
+        bits |= uint64_t{1} << (index % 64);
+        return;
+      }
+      self.propose(p, index, value, interpolated);
+    }
+
+    void flush() {
+      if (bits == 0) return;
+      const uint64_t fresh = bits & ~self.settled_[word];
+      bits = 0;
+      if (fresh == 0) return;
+      const uint8_t owner = self.brick_owner_[word / kWordsPerBrick];
+      if (owner == p) {
+        self.pass_free_space(self.parts_[p], word, fresh);
+      } else {
+        self.parts_[p].free_handed_over[owner].push_back({word, fresh});
+      }
+    }
+  };
+
+  /// A candidate other than free space from sector p's walks.
+  void propose(size_t p, size_t index, int32_t value, bool interpolated) {
+    // Settled free space stays as it is (the bits are a cache line a brick, mostly cached).
+    if (passes_settled_by(value, interpolated) &&
+        ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) {
+      return;
+    }
+    const uint32_t key = make_candidate(value, interpolated);
+    // Candidates only fall during a scan: one at or below this key already makes it moot.
+    const uint32_t current = candidates_[index].load(std::memory_order_relaxed);
+    if (key >= current) return;
+    const uint8_t owner = brick_owner_[index / kBrickVoxels];
+    if (owner == p) {
+      lower(parts_[p], index, key, current);
+    } else {
+      parts_[p].handed_over[owner].push_back({index, key});
+    }
+  }
+
   /// Sector p walks its rays: candidates for its own voxels are written, the others handed over.
   void march_sector(size_t p, const RayBatch& rays, const std::vector<uint32_t>& ray_ids,
                     const detail::RayMarchParams& params) {
-    Part& part = parts_[p];
-    const auto propose = [&](size_t index, int32_t value, bool interpolated)
-        __attribute__((always_inline)) {
-      // Settled free space stays as it is (the bits are a cache line a brick, mostly cached).
-      if (passes_settled_by(value, interpolated) &&
-          ((settled_[index / 64] >> (index % 64)) & 1u) != 0u) {
-        return;
-      }
-      const uint8_t owner = brick_owner_[index / kBrickVoxels];
-      if (value == kValueScale && !interpolated && owner == p) {
-        pass_free_space(part, index);
-        return;
-      }
-      const uint32_t key = make_candidate(value, interpolated);
-      // Candidates only fall during a scan: one at or below this key already makes it moot.
-      // (Near the sensor, where every ray passes, that is nearly every visit.)
-      const uint32_t current = candidates_[index].load(std::memory_order_relaxed);
-      if (key >= current) return;
-      if (owner == p) {
-        lower(part, index, key, current);
-      } else {
-        part.handed_over[owner].push_back({index, key});
-      }
-    };
     detail::RayMarchParams flat = params;
     flat.interpolation_slope = 0.0f;
+    SectorVisitor visit{*this, p};
     for (const uint32_t i : ray_ids) {
       detail::RayMarchParams ray = rays.may_interpolate(i) ? params : flat;
       ray.carve_from_m = detail::carving_start(settings_.carve_free_space, settings_.dense_range_m,
                                                rays.carving_level_of(i));
-      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, propose,
+      detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, visit,
                        settled_bricks_.data());
     }
+    visit.flush();
   }
 
   /// Sector p applies what the other sectors handed over to it.
@@ -354,19 +399,17 @@ class CpuIntegrator final : public Integrator {
         const uint32_t current = candidates_[h.index].load(std::memory_order_relaxed);
         if (h.key < current) lower(parts_[p], h.index, h.key, current);
       }
+      for (const FreeBits& f : from.free_handed_over[p]) pass_free_space(parts_[p], f.word, f.bits);
     }
   }
 
-  /// Free space passed in a voxel of `part`'s sector: every such visit proposes the same key
-  /// (+tau, measured), so a bit per voxel says it all, and the fusion takes min(candidate, +tau)
-  /// where it is set. Bits are a cache line a brick; a candidate load was a cache line a few
-  /// voxels, at almost every step of a walk.
-  void pass_free_space(Part& part, size_t index) {
-    uint64_t& word = free_space_[index / 64];
-    const uint64_t bit = uint64_t{1} << (index % 64);
-    if ((word & bit) != 0) return;
-    word |= bit;
-    list_brick(part, index / kBrickVoxels);
+  /// Free space passed in voxels of `part`'s sector: the bits of one 64-voxel word (see
+  /// SectorVisitor). Bits are a cache line a brick.
+  void pass_free_space(Part& part, size_t word, uint64_t bits) {
+    uint64_t& passed = free_space_[word];
+    if ((passed | bits) == passed) return;
+    passed |= bits;
+    list_brick(part, word / kWordsPerBrick);
   }
 
   /// Lists a brick for the fusion once.
