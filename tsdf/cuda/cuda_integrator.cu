@@ -150,7 +150,7 @@ __global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, uint32_t
 
 // At most 64 registers, so that four blocks share a multiprocessor: on an H100 or H200 (132
 // of them) every ray of an OS1-128 scan is then walked in one wave. (A walk without the limit
-// takes 80 registers, three blocks: a second wave for the last rays.)
+// takes 78 registers, three blocks: a second wave for the last rays.)
 __global__ void __launch_bounds__(kThreads, 4)
     min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
                     const uint8_t* interpolate, const uint8_t* carving_level, bool carve_free_space,
