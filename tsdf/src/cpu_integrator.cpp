@@ -230,37 +230,26 @@ class CpuIntegrator final : public Integrator {
   /// bricks); resets them and returns how many voxels there were.
   size_t fuse_brick(size_t brick, int32_t falloff, uint32_t max_weight) {
     size_t updated = 0;
-    const uint32_t free_weight = candidate_weight(kValueScale, falloff);
     for (size_t word = brick * kWordsPerBrick; word < (brick + 1) * kWordsPerBrick; ++word) {
       const uint64_t with_key = occupancy_[word];
       const uint64_t passed_free = free_space_[word];
       occupancy_[word] = 0;
       free_space_[word] = 0;
       uint64_t settled = settled_[word];
-      const auto fuse_into = [&](size_t index, uint64_t bit, int32_t value, uint32_t weight) {
-        const uint32_t fused = pack(tsdf::fuse(unpack(map_[index]), value, weight, max_weight));
+      for (uint64_t bits = with_key | passed_free; bits != 0; bits &= bits - 1) {
+        const uint64_t bit = bits & (~bits + 1);
+        const size_t index = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
+        uint32_t key = kEmptyCandidate;
+        if ((with_key & bit) != 0) {
+          key = candidates_[index].load(std::memory_order_relaxed);
+          candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
+        }
+        if ((passed_free & bit) != 0 && kFreeSpaceKey < key) key = kFreeSpaceKey;
+        const int32_t value = candidate_value(key);
+        const uint32_t fused = pack(
+            tsdf::fuse(unpack(map_[index]), value, candidate_weight(value, falloff), max_weight));
         map_[index] = fused;
         settled = fused == settled_voxel_ ? settled | bit : settled & ~bit;
-      };
-      if (with_key == 0) {
-        // Free space only (most words): +tau at full weight everywhere a bit is set.
-        for (uint64_t bits = passed_free; bits != 0; bits &= bits - 1) {
-          fuse_into(word * 64 + static_cast<size_t>(__builtin_ctzll(bits)), bits & (~bits + 1),
-                    kValueScale, free_weight);
-        }
-      } else {
-        for (uint64_t bits = with_key | passed_free; bits != 0; bits &= bits - 1) {
-          const uint64_t bit = bits & (~bits + 1);
-          const size_t index = word * 64 + static_cast<size_t>(__builtin_ctzll(bits));
-          uint32_t key = kEmptyCandidate;
-          if ((with_key & bit) != 0) {
-            key = candidates_[index].load(std::memory_order_relaxed);
-            candidates_[index].store(kEmptyCandidate, std::memory_order_relaxed);
-          }
-          if ((passed_free & bit) != 0 && kFreeSpaceKey < key) key = kFreeSpaceKey;
-          const int32_t value = candidate_value(key);
-          fuse_into(index, bit, value, candidate_weight(value, falloff));
-        }
       }
       settled_[word] = settled;
       updated += static_cast<size_t>(__builtin_popcountll(with_key | passed_free));
