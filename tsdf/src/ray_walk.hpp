@@ -166,9 +166,8 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   // Storage strides of one step inside a brick, per axis.
   const int64_t local_stride[3] = {1, kBrickSize, kBrickSize * kBrickSize};
   int64_t index = static_cast<int64_t>(linear());
-  // Storage distance between neighbouring brick slots along an axis, and the ring buffer's
-  // length along it (a slot that wraps around moves that much back, or on). Computed where
-  // needed, from registers the walk holds anyway.
+  // Storage distance between neighbouring brick slots along an axis. Computed where needed,
+  // from registers the walk holds anyway.
   const auto slot_stride = [&](auto axis_constant) -> int64_t {
     constexpr int axis = decltype(axis_constant)::value;
     return static_cast<int64_t>(kBrickVoxels) * (axis > 0 ? bricks[0] : 1) *
@@ -233,18 +232,12 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
                    dir_c[axis];
     }
     if (static_cast<uint32_t>(local[axis]) >= static_cast<uint32_t>(kBrickSize)) {
-      // To the same place in the neighbouring brick slot.
-      const int64_t stride = slot_stride(axis_constant);
-      local[axis] -= s * kBrickSize;
-      brick[axis] += s;
-      index += s * (stride - kBrickSize * local_stride[axis]);
-      if (brick[axis] == bricks[axis]) {
-        brick[axis] = 0;
-        index -= bricks[axis] * stride;
-      } else if (brick[axis] < 0) {
-        brick[axis] = bricks[axis] - 1;
-        index += bricks[axis] * stride;
-      }
+      // To the near side of the next brick slot (wrapping around the ring buffer): the index
+      // moves by the slots passed and back across the brick's width.
+      const int32_t old_brick = brick[axis];
+      enter_next_brick(local[axis], brick[axis], s, bricks[axis]);
+      index += (brick[axis] - old_brick) * slot_stride(axis_constant) -
+               s * kBrickSize * local_stride[axis];
       new_brick = settled_bricks != nullptr;
     }
   };
