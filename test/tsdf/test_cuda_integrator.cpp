@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "analytic_rays.hpp"
 #include "box_room_rays.hpp"
@@ -130,6 +132,18 @@ TEST(CudaIntegrator, ReportsItsDeviceMemory) {
   const size_t volume = s.map_dim().x * static_cast<size_t>(s.map_dim().y) * s.map_dim().z * 4;
   EXPECT_GE(gpu->memory_bytes(), 2 * volume);
   EXPECT_EQ(gpu->backend_name(), "cuda");
+}
+
+TEST(CudaIntegrator, RefusesAMapOfMoreThanTwoToThe32Voxels) {
+  SKIP_WITHOUT_GPU();
+  TsdfSettings s;
+  s.map_size_m = {300.0f, 300.0f, 30.0f};  // 4688 x 4688 x 472 voxels at 6.4 cm: 1.0e10
+  try {
+    make_cuda_integrator(s, test::make_vec(0, 0, 0));
+    ADD_FAILURE() << "no error for a map of 1e10 voxels";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 2^32"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -73,7 +73,7 @@ struct ProposeCandidate {
   const uint32_t* settled;
   uint32_t* free_space;  ///< a bit per voxel that a ray passed in free space this scan
 
-  __device__ void operator()(size_t index, int32_t value, bool interpolated) const {
+  __device__ void operator()(uint32_t index, int32_t value, bool interpolated) const {
     // Both loads are issued before either is needed, so the walk waits for memory once per
     // voxel, not twice. Keys only decrease during a scan, so a stale read can only cause an
     // unneeded atomic.
@@ -110,12 +110,12 @@ struct WalkVisitor {
   uint32_t bits = 0;
   uint32_t settled_word = 0;
 
-  __device__ void operator()(size_t index, int32_t value, bool interpolated) {
+  __device__ void operator()(uint32_t index, int32_t value, bool interpolated) {
     if (value != kValueScale || interpolated) {
       propose(index, value, interpolated);
       return;
     }
-    const auto w = static_cast<uint32_t>(index / 32);
+    const uint32_t w = index / 32;
     if (w != word) {
       flush();
       word = w;
@@ -284,6 +284,12 @@ class CudaIntegrator final : public Integrator {
   CudaIntegrator(const TsdfSettings& settings, Vec3 centre_m)
       : settings_(settings), geometry_(centred_geometry(settings, centre_m)) {
     const size_t n = geometry_.voxel_count();
+    // The walks follow the storage index in 32 bits (ray_walk.hpp, WalkIndex).
+    if (n > size_t{UINT32_MAX}) {
+      throw std::invalid_argument("a local map of " + std::to_string(n) +
+                                  " voxels: the CUDA backend holds at most 2^32 - 1 a volume "
+                                  "(a larger voxel or a smaller map)");
+    }
     FEATSENSE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
     host_memory::enable_page_locking({&allocate_page_locked, &release_page_locked});
     int device = 0;
