@@ -49,6 +49,59 @@ FEATSENSE_HD_INLINE float walk_end(float t_enter, float range, const RayMarchPar
   return end > t_enter ? end : t_enter;
 }
 
+/// A walk measures its way along the ray in ticks: integers, 2^-27 of the distance from the
+/// walk's start to the ray's origin each, so a walk spans at most kWalkTicks. Sums of integers
+/// do not depend on their order, so the j-th face crossing along an axis is first + j * delta
+/// whether a walk steps to it face by face or computes it in one go, as ray_walk.hpp's jumps
+/// across whole bricks do (sums of floats would round differently). The unit depends only on
+/// where the walk starts, not on where it ends, so a walk that stops early (sparse carving)
+/// crosses the same faces at the same ticks as the whole walk of its ray. A tick is under half a
+/// micrometre for a ray of 60 m, finer than a float's rounding there.
+constexpr int32_t kWalkTicks = 1 << 27;
+/// Any t beyond the walk's end: only "later than the end" matters there (the walk stops).
+constexpr int32_t kBeyondWalk = kWalkTicks + 1;
+
+struct WalkClock {
+  float ticks_per_metre;  ///< kWalkTicks / the distance from the walk's start to the origin
+
+  /// t metres from the walk's start in ticks, rounded down, clamped to [0, kBeyondWalk].
+  FEATSENSE_HD_INLINE int32_t ticks(float t_m) const {
+    const float x = t_m * ticks_per_metre;
+    if (!(x > 0.0f)) return 0;  // NaN too
+    if (x > static_cast<float>(kWalkTicks)) return kBeyondWalk;
+    return static_cast<int32_t>(x);
+  }
+};
+
+/// Where a walk crosses the voxel faces along one axis: the first crossing and the spacing of
+/// the next ones, in ticks (at least one, so that every step moves on), and the direction of
+/// the step; an axis the walk runs parallel to is never crossed.
+struct AxisCrossings {
+  int32_t step;
+  int32_t first;
+  int32_t delta;
+};
+
+/// voxel: the walk's start voxel along the axis; origin and direction: the walk's start and
+/// direction along it.
+FEATSENSE_HD_INLINE AxisCrossings axis_crossings(float origin, float direction, int32_t voxel,
+                                                 float voxel_size_m, const WalkClock& clock) {
+  const auto spacing = [&](float metres) {
+    const int32_t delta = clock.ticks(metres);
+    return delta > 0 ? delta : 1;
+  };
+  if (direction > 0.0f) {
+    return {1,
+            clock.ticks(((static_cast<float>(voxel) + 1.0f) * voxel_size_m - origin) / direction),
+            spacing(voxel_size_m / direction)};
+  }
+  if (direction < 0.0f) {
+    return {-1, clock.ticks((static_cast<float>(voxel) * voxel_size_m - origin) / direction),
+            spacing(-voxel_size_m / direction)};
+  }
+  return {0, kBeyondWalk, kBeyondWalk};
+}
+
 /// Clips the segment origin + t * dir, t in [t0, t1], to the box [lo, hi]; false if it misses.
 FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, float& t0,
                                      float& t1) {
@@ -103,34 +156,25 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
   const Vec3 walk_start = origin + t1 * dir;
   const Vec3 walk_dir = -1.0f * dir;
   const float walk_length = t1 - walk_end(t0, range, params, vs);
+  const WalkClock clock{static_cast<float>(kWalkTicks) / t1};
+  const int32_t walk_end_ticks = clock.ticks(walk_length);
   Index3 voxel = map.voxel_of(walk_start);
   int32_t step[3];
-  float t_next[3];
-  float t_delta[3];
+  int32_t t_next[3];  // ticks
+  int32_t t_delta[3];
   for (int axis = 0; axis < 3; ++axis) {
-    const float d = component(walk_dir, axis);
-    const float o = component(walk_start, axis);
-    const int32_t v = component(voxel, axis);
-    if (d > 0.0f) {
-      step[axis] = 1;
-      t_next[axis] = ((static_cast<float>(v) + 1.0f) * vs - o) / d;
-      t_delta[axis] = vs / d;
-    } else if (d < 0.0f) {
-      step[axis] = -1;
-      t_next[axis] = (static_cast<float>(v) * vs - o) / d;
-      t_delta[axis] = -vs / d;
-    } else {
-      step[axis] = 0;
-      t_next[axis] = FLT_MAX;
-      t_delta[axis] = FLT_MAX;
-    }
+    const AxisCrossings c = axis_crossings(component(walk_start, axis), component(walk_dir, axis),
+                                           component(voxel, axis), vs, clock);
+    step[axis] = c.step;
+    t_next[axis] = c.first;
+    t_delta[axis] = c.delta;
   }
 
   const float tau = params.truncation_m;
-  float t = 0.0f;
+  int32_t t = 0;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
+  for (int32_t i = 0; i < max_steps && t <= walk_end_ticks; ++i) {
     if (map.contains(voxel)) {
       const Vec3 centre = map.centre_of(voxel);
       const float along = dot(centre - origin, dir);

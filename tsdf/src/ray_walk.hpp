@@ -37,69 +37,52 @@ FEATSENSE_HD_INLINE void enter_next_brick(int32_t& local, int32_t& brick, int32_
 /// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
 struct BrickExit {
   int axis;            ///< the axis whose crossing leaves the brick
-  float t;             ///< the walk's t at that crossing
+  int32_t t;           ///< the walk's t at that crossing (ticks)
   int32_t crossed[3];  ///< face crossings per axis up to and including it
-  float t_next[3];     ///< the next crossing per axis after them
+  int32_t t_next[3];   ///< the next crossing per axis after them
 };
 
 /// The exit of the walk from its current brick (`local`: its place in the brick), computed
 /// without stepping through the voxels: crossings of voxel faces come in the order of their
-/// t, the lower axis first on ties (the rule of the walk's step), and each axis's crossings are
-/// the same running sums t_next += t_delta, so the state is exactly the one that stepping voxel
-/// by voxel reaches. A brick all of whose voxels would pass every candidate by can so be
-/// crossed in one jump. False where the walk ends (t > walk_length) before the exit.
-/// No axis crosses more than kBrickSize faces inside a brick. On the GPU every loop runs that
-/// many turns, its additions conditional (selects, not branches that would split a warp by
-/// each lane's count); the CPU leaves each loop where its count ends (a predicted branch costs
-/// it less than the idle turns: 20 % slower otherwise).
+/// t, the lower axis first on ties (the rule of the walk's step), and an axis's crossings are
+/// t_next + j * t_delta in exact integer ticks (WalkClock), so the state is exactly the one that
+/// stepping voxel by voxel reaches. A brick all of whose voxels would pass every candidate by
+/// can so be crossed in one jump. False where the walk ends (t > walk_end_ticks) before the
+/// exit.
+/// Nothing depends on an earlier result but the exit itself, and no loop's length on the
+/// lane, so on the GPU a warp's jumping lanes run one short code path together.
 FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
-                                    const float t_next[3], const float t_delta[3],
-                                    float walk_length, BrickExit& exit) {
-#ifdef __CUDA_ARCH__
-  constexpr bool kFixedTurns = true;
-#else
-  constexpr bool kFixedTurns = false;
-#endif
+                                    const int32_t t_next[3], const int32_t t_delta[3],
+                                    int32_t walk_end_ticks, BrickExit& exit) {
   // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
+  // Ticks stay below 2^31: t_next <= 2 kBeyondWalk and t_delta <= kBeyondWalk = 2^27 + 1.
   int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
   exit.axis = -1;
-  exit.t = 0.0f;
+  exit.t = 0;
   for (int axis = 0; axis < 3; ++axis) {
     if (step[axis] == 0) continue;
     to_leave[axis] = step[axis] > 0 ? kBrickSize - local[axis] : local[axis] + 1;
-    float tn = t_next[axis];
-    for (int32_t k = 1; k < kBrickSize; ++k) {
-      const bool more = k < to_leave[axis];
-      if (!kFixedTurns && !more) break;
-      if (more) tn += t_delta[axis];
-    }
-    if (exit.axis < 0 || tn < exit.t) {
+    const int32_t t_out = t_next[axis] + (to_leave[axis] - 1) * t_delta[axis];
+    if (exit.axis < 0 || t_out < exit.t) {
       exit.axis = axis;
-      exit.t = tn;
+      exit.t = t_out;
     }
   }
-  if (exit.axis < 0) return false;
-  if (!(exit.t <= walk_length)) return false;
+  if (exit.axis < 0 || exit.t > walk_end_ticks) return false;
   for (int axis = 0; axis < 3; ++axis) {
     int32_t crossed = 0;
-    float tn = t_next[axis];
     if (axis == exit.axis) {
       crossed = to_leave[axis];
-      tn = exit.t + t_delta[axis];
     } else if (step[axis] != 0) {
-      // The crossings before the exit: fewer than to_leave[axis] (else this axis would leave
-      // first), so fewer than kBrickSize; once one is not before it, none after it is.
-      for (int32_t k = 1; k < kBrickSize; ++k) {
-        const bool before = tn < exit.t || (tn == exit.t && axis < exit.axis);
-        if (!kFixedTurns && !before) break;
-        if (before) {
-          tn += t_delta[axis];
-          ++crossed;
-        }
+      // The crossings before the exit (at a tie, those of a lower axis): fewer than
+      // to_leave[axis], else this axis would leave first, so fewer than kBrickSize.
+      const int32_t before = exit.t + (axis < exit.axis ? 1 : 0);
+      for (int32_t j = 0; j < kBrickSize - 1; ++j) {
+        crossed += t_next[axis] + j * t_delta[axis] < before ? 1 : 0;
       }
     }
     exit.crossed[axis] = crossed;
-    exit.t_next[axis] = tn;
+    exit.t_next[axis] = t_next[axis] + crossed * t_delta[axis];
   }
   return true;
 }
@@ -145,14 +128,16 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   const Vec3 walk_start = origin + t1 * dir;
   const Vec3 walk_dir = -1.0f * dir;
   const float walk_length = t1 - walk_end(t0, range, params, vs);
+  const WalkClock clock{static_cast<float>(kWalkTicks) / t1};
+  const int32_t walk_end_ticks = clock.ticks(walk_length);
   const Index3 start = map.voxel_of(walk_start);
   const Index3 start_brick = map.wrapped_brick(start);
   const Index3 start_local = LocalMapGeometry::local_in_brick(start);
   const Index3 nb = map.bricks();
 
   int32_t step[3] = {};
-  float t_next[3] = {};
-  float t_delta[3] = {};
+  int32_t t_next[3] = {};  // ticks (WalkClock)
+  int32_t t_delta[3] = {};
   int32_t offset[3] = {};  // global index less the map's lowest corner: inside when in [0, dim)
   int32_t dim[3] = {};     // voxels per axis
   int32_t brick[3] = {};   // ring-buffer slot coordinates of the current brick
@@ -162,22 +147,12 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   float origin_c[3] = {};
   float dir_c[3] = {};
   for (int axis = 0; axis < 3; ++axis) {
-    const float d = component(walk_dir, axis);
-    const float o = component(walk_start, axis);
     const int32_t v = component(start, axis);
-    if (d > 0.0f) {
-      step[axis] = 1;
-      t_next[axis] = ((static_cast<float>(v) + 1.0f) * vs - o) / d;
-      t_delta[axis] = vs / d;
-    } else if (d < 0.0f) {
-      step[axis] = -1;
-      t_next[axis] = (static_cast<float>(v) * vs - o) / d;
-      t_delta[axis] = -vs / d;
-    } else {
-      step[axis] = 0;
-      t_next[axis] = FLT_MAX;
-      t_delta[axis] = FLT_MAX;
-    }
+    const AxisCrossings c =
+        axis_crossings(component(walk_start, axis), component(walk_dir, axis), v, vs, clock);
+    step[axis] = c.step;
+    t_next[axis] = c.first;
+    t_delta[axis] = c.delta;
     offset[axis] = v - component(map.origin, axis);
     dim[axis] = component(map.dim, axis);
     brick[axis] = component(start_brick, axis);
@@ -218,14 +193,14 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   };
 
   const float tau = params.truncation_m;
-  float t = 0.0f;
+  int32_t t = 0;
 
-  const float free_from = free_space_from(t1, range, tau, vs);
+  const int32_t free_from = clock.ticks(free_space_from(t1, range, tau, vs));
   // Jumps from the current voxel to the first one after its brick (brick_exit). Returns the
   // steps taken, or -1 where the walk ends before it leaves the brick.
   const auto leave_brick = [&]() -> int32_t {
     BrickExit exit;
-    if (!brick_exit(step, local, t_next, t_delta, walk_length, exit)) return -1;
+    if (!brick_exit(step, local, t_next, t_delta, walk_end_ticks, exit)) return -1;
     for (int axis = 0; axis < 3; ++axis) {
       const int32_t moved = step[axis] * exit.crossed[axis];
       t_next[axis] = exit.t_next[axis];
@@ -279,7 +254,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   };
 
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  for (int32_t i = 0; i < max_steps && t <= walk_length; ++i) {
+  for (int32_t i = 0; i < max_steps && t <= walk_end_ticks; ++i) {
     const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
                         static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
                         static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
