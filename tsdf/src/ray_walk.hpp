@@ -7,9 +7,9 @@
 // bookkeeping is cheaper:
 // - the storage index and the map-bounds test follow the traversal incrementally instead of
 //   being recomputed from the global index at every voxel, across brick faces too;
-// - of the projective distance, only the term of the axis just stepped is recomputed (each
-//   term is the same product as in march_ray, and the sum is formed in the same order), and
-//   none from where the rest of the walk is free space (free_space_from);
+// - the projective distance (march_ray's own expression) is computed only where a voxel may
+//   lie in the truncation band, not from where the rest of the walk is free space
+//   (free_space_from);
 // - free space (d >= tau) needs no division: d / tau >= 1 there, so the clamped value is
 //   exactly kValueScale, and there is no interpolation;
 // - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
@@ -143,9 +143,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   int32_t brick[3] = {};   // ring-buffer slot coordinates of the current brick
   int32_t local[3] = {};   // place in the brick
   int32_t bricks[3] = {};  // bricks per axis
-  float term[3] = {};      // (centre - origin)[axis] * dir[axis], as dot() forms it
-  float origin_c[3] = {};
-  float dir_c[3] = {};
   for (int axis = 0; axis < 3; ++axis) {
     const int32_t v = component(start, axis);
     const AxisCrossings c =
@@ -158,10 +155,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     brick[axis] = component(start_brick, axis);
     local[axis] = component(start_local, axis);
     bricks[axis] = component(nb, axis);
-    origin_c[axis] = component(origin, axis);
-    dir_c[axis] = component(dir, axis);
-    // centre_of(voxel)[axis] - origin[axis], times dir[axis]: the terms of dot() in march_ray.
-    term[axis] = ((static_cast<float>(v) + 0.5f) * vs - origin_c[axis]) * dir_c[axis];
   }
   const auto linear = [&] {
     return map.linear_from({brick[0], brick[1], brick[2]}, {local[0], local[1], local[2]});
@@ -206,7 +199,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       t_next[axis] = exit.t_next[axis];
       offset[axis] += moved;
       local[axis] += moved;
-      // (The terms are not needed any more: a jump is made in free space only.)
     }
     t = exit.t;
     for (int axis = 0; axis < 3; ++axis) {  // constant indices keep the arrays in registers
@@ -227,7 +219,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   // A step along `axis` if `taken` (every axis is passed through, so that on the GPU the
   // untaken ones are selects, not branches). Crossing a brick face moves the storage index
   // to the neighbouring brick slot by constants, wrapping around the ring buffer.
-  const auto advance = [&](bool taken, auto axis_constant, bool in_free_space) {
+  const auto advance = [&](bool taken, auto axis_constant) {
     constexpr int axis = decltype(axis_constant)::value;
     const int32_t s = taken ? step[axis] : 0;
     if (taken) t = t_next[axis];
@@ -235,12 +227,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     offset[axis] += s;
     local[axis] += s;
     index += static_cast<WalkIndex>(s) * local_stride[axis];
-    // Terms are only needed before free space starts (and t only grows).
-    if (taken && !in_free_space) {
-      term[axis] = ((static_cast<float>(offset[axis] + component(map.origin, axis)) + 0.5f) * vs -
-                    origin_c[axis]) *
-                   dir_c[axis];
-    }
     if (static_cast<uint32_t>(local[axis]) >= static_cast<uint32_t>(kBrickSize)) {
       // To the near side of the next brick slot (wrapping around the ring buffer): the index
       // moves by the slots passed and back across the brick's width.
@@ -259,7 +245,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
                         static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
                         static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
     // From free_from on, every voxel is free space (free_space_from): march_ray's distance
-    // there is always >= tau, so it is not computed, nor the terms it is made of.
+    // there is always >= tau, so it is not computed.
     const bool in_free_space = t >= free_from;
     bool jump = false;
     if (new_brick) {
@@ -280,7 +266,10 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
         if (in_free_space) {
           visit(index, kValueScale, false);
         } else {
-          const float along = (term[0] + term[1]) + term[2];
+          const Index3 g{offset[0] + map.origin.x, offset[1] + map.origin.y,
+                         offset[2] + map.origin.z};
+          const Vec3 centre = map.centre_of(g);
+          const float along = dot(centre - origin, dir);
           const float distance = range - along;
           if (distance >= tau) {
             visit(index, kValueScale, false);
@@ -288,9 +277,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
             const int32_t value = distance_to_fixed(distance, tau);
             visit(index, value, false);
             if (interpolate) {
-              const Index3 g{offset[0] + map.origin.x, offset[1] + map.origin.y,
-                             offset[2] + map.origin.z};
-              const Vec3 centre = map.centre_of(g);
               const float half_height = params.interpolation_slope * along;
               const int32_t reach = static_cast<int32_t>(half_height / vs);
               for (int32_t k = 1; k <= reach; ++k) {
@@ -319,16 +305,16 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       constexpr std::integral_constant<int, 1> y;
       constexpr std::integral_constant<int, 2> z;
 #ifdef __CUDA_ARCH__
-      advance(!along_z && !y_first, x, in_free_space);
-      advance(!along_z && y_first, y, in_free_space);
-      advance(along_z, z, in_free_space);
+      advance(!along_z && !y_first, x);
+      advance(!along_z && y_first, y);
+      advance(along_z, z);
 #else
       if (along_z) {
-        advance(true, z, in_free_space);
+        advance(true, z);
       } else if (y_first) {
-        advance(true, y, in_free_space);
+        advance(true, y);
       } else {
-        advance(true, x, in_free_space);
+        advance(true, x);
       }
 #endif
     }
