@@ -133,19 +133,29 @@ struct WalkVisitor {
   }
 };
 
-/// The marked bricks, listed for the fusion (in no particular order; one atomic per warp).
-__global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, uint32_t brick_count,
-                                           uint32_t* touched_bricks, uint32_t* touched_count) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  const bool touched = i < brick_count && brick_flags[i] != 0u;
-  const unsigned int lanes = __ballot_sync(0xffffffffu, touched);
+/// Appends the calling lanes' items to a list, one atomic per warp (in no particular order).
+__device__ void append_warp_items(bool take, uint32_t item, uint32_t* list, uint32_t* count) {
+  const unsigned int lanes = __ballot_sync(0xffffffffu, take);
   if (lanes == 0u) return;
   const int lane = static_cast<int>(threadIdx.x % 32u);
   const int leader = __ffs(static_cast<int>(lanes)) - 1;
   uint32_t first = 0;
-  if (lane == leader) first = atomicAdd(touched_count, static_cast<uint32_t>(__popc(lanes)));
+  if (lane == leader) first = atomicAdd(count, static_cast<uint32_t>(__popc(lanes)));
   first = __shfl_sync(0xffffffffu, first, leader);
-  if (touched) touched_bricks[first + __popc(lanes & ((1u << lane) - 1u))] = i;
+  if (take) list[first + __popc(lanes & ((1u << lane) - 1u))] = item;
+}
+
+/// The marked bricks, listed for the fusion: those with a candidate, and those only passed in
+/// free space (most of them), which the fusion treats apart.
+__global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, const uint32_t* band_bricks,
+                                           uint32_t brick_count, uint32_t* band_list,
+                                           uint32_t* band_count, uint32_t* free_list,
+                                           uint32_t* free_count) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const bool touched = i < brick_count && brick_flags[i] != 0u;
+  const bool band = touched && band_bricks[i] != 0u;
+  append_warp_items(band, i, band_list, band_count);
+  append_warp_items(touched && !band, i, free_list, free_count);
 }
 
 // At most 64 registers, so that four blocks share a multiprocessor: on an H100 or H200 (132
@@ -178,11 +188,71 @@ __global__ void __launch_bounds__(kThreads, 4)
 /// voxel 32 r + l of round r.
 constexpr int kFuseRounds = kBrickVoxels / 32;
 
-/// One warp per touched brick: fuses the candidates, and +tau where a free-space bit is set,
-/// into the map, resets them and the brick's flag for the next scan, and renews the brick's settled
-/// bits and flag. Each lane first loads all its 16 keys, then the map voxels of those that got one,
-/// so that a warp has up to 32 loads in flight: with one voxel a thread and a barrier per brick,
-/// the fusion waited for memory brick by brick (a quarter of an outdoor scan's time).
+/// One warp per brick that was only passed in free space (no candidate): fuses +tau,
+/// measured, into the voxels whose bit is set (none of them settled: the walks leave settled
+/// voxels out), resets the bits and the brick's flag, and renews its settled bits and flag.
+/// Rounds without a bit are skipped (the whole warp sees the same word) and keep their settled
+/// bits. A kernel of its own: without keys it needs half the registers of the other bricks'
+/// fusion, and the code of neither slows the other.
+__global__ void __launch_bounds__(kThreads, 4)
+    fuse_free_bricks_kernel(const uint32_t* __restrict__ free_bricks,
+                            const uint32_t* __restrict__ free_count,
+                            uint32_t* __restrict__ brick_flags, uint32_t* __restrict__ map,
+                            uint32_t* __restrict__ settled, uint32_t* __restrict__ free_space,
+                            uint8_t* __restrict__ settled_bricks, int32_t falloff,
+                            uint32_t max_weight, uint32_t* __restrict__ voxels_updated) {
+  const uint32_t count = *free_count;
+  const uint32_t settled_voxel = settled_free_voxel(max_weight);
+  const uint32_t free_weight = candidate_weight(kValueScale, falloff);
+  const uint32_t lane = threadIdx.x % 32u;
+  const uint32_t warps = gridDim.x * blockDim.x / 32u;
+  uint32_t updated = 0;  // lane 0's count over its bricks
+  for (uint32_t k = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; k < count; k += warps) {
+    const uint32_t brick = free_bricks[k];
+    const size_t first = static_cast<size_t>(brick) * kBrickVoxels;
+    const bool word_lane = lane < static_cast<uint32_t>(kFuseRounds);
+    const uint32_t settled_word = word_lane ? settled[first / 32 + lane] : 0u;
+    const uint32_t free_word = word_lane ? free_space[first / 32 + lane] : 0u;
+    if (free_word != 0u) free_space[first / 32 + lane] = 0u;
+    uint32_t voxels[kFuseRounds];
+#pragma unroll
+    for (int r = 0; r < kFuseRounds; ++r) {
+      const bool passed = ((__shfl_sync(0xffffffffu, free_word, r) >> lane) & 1u) != 0u;
+      voxels[r] = passed ? map[first + r * 32 + lane] : 0u;
+    }
+    bool all_settled = true;
+#pragma unroll
+    for (int r = 0; r < kFuseRounds; ++r) {
+      const uint32_t passed_word = __shfl_sync(0xffffffffu, free_word, r);
+      uint32_t word = __shfl_sync(0xffffffffu, settled_word, r);
+      if (passed_word != 0u) {
+        const size_t index = first + r * 32 + lane;
+        bool is_settled = ((word >> lane) & 1u) != 0u;
+        if (((passed_word >> lane) & 1u) != 0u) {
+          const uint32_t fused =
+              pack(fuse(unpack(voxels[r]), kValueScale, free_weight, max_weight));
+          map[index] = fused;
+          is_settled = fused == settled_voxel;
+        }
+        word = write_warp_bits(settled, index, is_settled);
+        updated += static_cast<uint32_t>(__popc(passed_word));
+      }
+      all_settled = all_settled && word == 0xffffffffu;
+    }
+    if (lane == 0u) {
+      brick_flags[brick] = 0u;
+      settled_bricks[brick] = all_settled ? 1u : 0u;
+    }
+  }
+  if (lane == 0u && updated != 0u) atomicAdd(voxels_updated, updated);
+}
+
+/// One warp per brick with a candidate: fuses the candidates, and +tau where a free-space bit
+/// is set, into the map, resets them and the brick's flags for the next scan, and renews the
+/// brick's settled bits and flag. Each lane first loads all its 16 keys, then the map voxels of
+/// those that got one, so that a warp has up to 32 loads in flight: with one voxel a thread and
+/// a barrier per brick, the fusion waited for memory brick by brick (a quarter of an outdoor
+/// scan's time).
 // At most 64 registers (four blocks a multiprocessor instead of three): more warps waiting
 // for memory at once outweigh the few values it keeps in local memory (outdoor fusion 210 ->
 // 200 µs on an H100).
@@ -208,14 +278,11 @@ __global__ void __launch_bounds__(kThreads, 4)
     const uint32_t settled_word = word_lane ? settled[first / 32 + lane] : 0u;
     const uint32_t free_word = word_lane ? free_space[first / 32 + lane] : 0u;
     if (free_word != 0u) free_space[first / 32 + lane] = 0u;
-    // Most touched bricks were only passed in free space (no candidate): their keys are not
-    // read at all.
-    const bool with_keys = band_bricks[brick] != 0u;
     uint32_t keys[kFuseRounds];
     uint32_t voxels[kFuseRounds];
 #pragma unroll
     for (int r = 0; r < kFuseRounds; ++r) {
-      keys[r] = with_keys ? candidates[first + r * 32 + lane] : kEmptyCandidate;
+      keys[r] = candidates[first + r * 32 + lane];
     }
     uint32_t stored = 0;  // bit r: the candidate slot of round r holds a key to reset
 #pragma unroll
@@ -246,7 +313,7 @@ __global__ void __launch_bounds__(kThreads, 4)
     }
     if (lane == 0u) {
       brick_flags[brick] = 0u;
-      if (with_keys) band_bricks[brick] = 0u;
+      band_bricks[brick] = 0u;
       settled_bricks[brick] = all_settled ? 1u : 0u;
     }
   }
@@ -308,6 +375,7 @@ class CudaIntegrator final : public Integrator {
     brick_flags_.reserve(bricks);
     band_bricks_.reserve(bricks);
     touched_bricks_.reserve(bricks);
+    free_bricks_.reserve(bricks);
     counters_.reserve(kCounters);
     host_counters_.reserve(kCounters);
     FEATSENSE_CUDA_CHECK(
@@ -328,8 +396,8 @@ class CudaIntegrator final : public Integrator {
   size_t memory_bytes() const override {
     return map_.bytes() + candidates_.bytes() + settled_.bytes() + free_space_.bytes() +
            settled_bricks_.bytes() + brick_flags_.bytes() + band_bricks_.bytes() +
-           touched_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() + origins_.bytes() +
-           counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
+           touched_bricks_.bytes() + free_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() +
+           origins_.bytes() + counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
            interpolate_.bytes() + carving_level_.bytes();
   }
 
@@ -385,6 +453,7 @@ class CudaIntegrator final : public Integrator {
     upload(rays, origin_count);
     uint32_t* kept_count = counters_.data() + kKeptRays;
     uint32_t* touched_count = counters_.data() + kTouchedBricks;
+    uint32_t* free_count = counters_.data() + kFreeBricks;
     uint32_t* updated_count = counters_.data() + kVoxelsUpdated;
     FEATSENSE_CUDA_CHECK(
         cudaMemsetAsync(counters_.data(), 0, kCounters * sizeof(uint32_t), stream_));
@@ -415,13 +484,18 @@ class CudaIntegrator final : public Integrator {
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     const auto brick_count = static_cast<uint32_t>(geometry_.voxel_count() / kBrickVoxels);
     list_touched_bricks_kernel<<<blocks_for(brick_count), kThreads, 0, stream_>>>(
-        brick_flags_.data(), brick_count, touched_bricks_.data(), touched_count);
+        brick_flags_.data(), band_bricks_.data(), brick_count, touched_bricks_.data(),
+        touched_count, free_bricks_.data(), free_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     fuse_bricks_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
         touched_bricks_.data(), touched_count, brick_flags_.data(), band_bricks_.data(),
         candidates_.data(), map_.data(), settled_.data(), free_space_.data(),
         settled_bricks_.data(), settings_.falloff_start_fixed(), settings_.max_weight_fixed(),
         updated_count);
+    fuse_free_bricks_kernel<<<resident_blocks_, kThreads, 0, stream_>>>(
+        free_bricks_.data(), free_count, brick_flags_.data(), map_.data(), settled_.data(),
+        free_space_.data(), settled_bricks_.data(), settings_.falloff_start_fixed(),
+        settings_.max_weight_fixed(), updated_count);
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     FEATSENSE_CUDA_CHECK(cudaMemcpyAsync(host_counters_.data(), counters_.data(),
                                          kCounters * sizeof(uint32_t), cudaMemcpyDeviceToHost,
@@ -433,7 +507,7 @@ class CudaIntegrator final : public Integrator {
   }
 
  private:
-  enum Counter { kKeptRays, kTouchedBricks, kVoxelsUpdated, kCounters };
+  enum Counter { kKeptRays, kTouchedBricks, kFreeBricks, kVoxelsUpdated, kCounters };
 
   void upload(const RayBatch& rays, size_t origin_count) {
     const size_t n = rays.size();
@@ -499,6 +573,7 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<uint32_t> brick_flags_;     ///< 1 while a brick is in touched_bricks_
   cuda::DeviceBuffer<uint32_t> band_bricks_;     ///< 1 per brick of those with a candidate
   cuda::DeviceBuffer<uint32_t> touched_bricks_;  ///< bricks with a candidate this scan
+  cuda::DeviceBuffer<uint32_t> free_bricks_;     ///< bricks only passed in free space
   unsigned int resident_blocks_ = 1;
   cuda::DeviceBuffer<uint32_t> kept_;
   cuda::DeviceBuffer<uint32_t> counters_;
