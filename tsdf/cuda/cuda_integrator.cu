@@ -207,12 +207,25 @@ __global__ void __launch_bounds__(kThreads, 4)
   const uint32_t lane = threadIdx.x % 32u;
   const uint32_t warps = gridDim.x * blockDim.x / 32u;
   uint32_t updated = 0;  // lane 0's count over its bricks
-  for (uint32_t k = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; k < count; k += warps) {
-    const uint32_t brick = free_bricks[k];
+  // A warp's bricks pass through a pipeline, so that its three waits for memory overlap: while
+  // one brick's voxels are fused, the next one's bit words and the index of the one after are
+  // on their way (otherwise each brick waits for its index, then its words, then its voxels).
+  const bool word_lane = lane < static_cast<uint32_t>(kFuseRounds);
+  const auto brick_at = [&](uint32_t k) { return k < count ? free_bricks[k] : 0u; };
+  const auto word_of = [&](const uint32_t* bits, uint32_t k, uint32_t brick) {
+    return k < count && word_lane ? bits[static_cast<size_t>(brick) * (kBrickVoxels / 32) + lane]
+                                  : 0u;
+  };
+  uint32_t k = (blockIdx.x * blockDim.x + threadIdx.x) / 32u;
+  uint32_t brick = brick_at(k);
+  uint32_t settled_word = word_of(settled, k, brick);
+  uint32_t free_word = word_of(free_space, k, brick);
+  uint32_t next_brick = brick_at(k + warps);
+  for (; k < count; k += warps) {
+    const uint32_t next_settled = word_of(settled, k + warps, next_brick);
+    const uint32_t next_free = word_of(free_space, k + warps, next_brick);
+    const uint32_t brick_after = brick_at(k + 2 * warps);
     const size_t first = static_cast<size_t>(brick) * kBrickVoxels;
-    const bool word_lane = lane < static_cast<uint32_t>(kFuseRounds);
-    const uint32_t settled_word = word_lane ? settled[first / 32 + lane] : 0u;
-    const uint32_t free_word = word_lane ? free_space[first / 32 + lane] : 0u;
     if (free_word != 0u) free_space[first / 32 + lane] = 0u;
     uint32_t voxels[kFuseRounds];
 #pragma unroll
@@ -243,6 +256,10 @@ __global__ void __launch_bounds__(kThreads, 4)
       brick_flags[brick] = 0u;
       settled_bricks[brick] = all_settled ? 1u : 0u;
     }
+    brick = next_brick;
+    settled_word = next_settled;
+    free_word = next_free;
+    next_brick = brick_after;
   }
   if (lane == 0u && updated != 0u) atomicAdd(voxels_updated, updated);
 }
