@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <stdexcept>
-#include <string>
 #include <vector>
 
 namespace featsense::app {
@@ -80,27 +78,18 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
   tsdf::RayBatch rays;
   rays.up = to_vec(pose_at(0.0).linear().col(2));
   rays.endpoints_m.reserve(scan.valid_count());
-  rays.origin_index.reserve(scan.valid_count());
+  rays.origins_m.reserve(scan.valid_count());
   rays.interpolate.reserve(scan.valid_count());
   rays.carving_level.reserve(scan.valid_count());
   const std::vector<uint8_t> flags = interpolation_flags(scan);
   // All rows of a column share the column's time in the layout of scan.hpp; take the time
   // of the first valid point so sources with per-point times are honoured per column.
-  // One origin per column with a valid point, which the column's points index.
-  if (scan.cols > 65536) {
-    throw std::invalid_argument("a scan of " + std::to_string(scan.cols) +
-                                " columns: at most 65536 can be deskewed");
-  }
   std::vector<std::optional<Eigen::Isometry3d>> column_pose(static_cast<size_t>(scan.cols));
-  std::vector<uint16_t> column_origin(static_cast<size_t>(scan.cols), 0);
   for (int col = 0; col < scan.cols; ++col) {
     for (int row = 0; row < scan.rows; ++row) {
       const size_t i = scan.index(row, col);
       if (!scan.valid[i]) continue;
-      const Eigen::Isometry3d pose = pose_at(static_cast<double>(scan.time_offset_s[i]));
-      column_pose[static_cast<size_t>(col)] = pose;
-      column_origin[static_cast<size_t>(col)] = static_cast<uint16_t>(rays.origins_m.size());
-      rays.origins_m.push_back(to_vec(pose.translation()));
+      column_pose[static_cast<size_t>(col)] = pose_at(static_cast<double>(scan.time_offset_s[i]));
       break;
     }
   }
@@ -109,7 +98,7 @@ tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_
     if (!scan.valid[i]) return;
     const Eigen::Isometry3d& pose = *column_pose[static_cast<size_t>(col)];
     rays.endpoints_m.push_back(to_vec(pose * scan.xyz[i].cast<double>()));
-    rays.origin_index.push_back(column_origin[static_cast<size_t>(col)]);
+    rays.origins_m.push_back(to_vec(pose.translation()));
     rays.interpolate.push_back(flags[i]);
     rays.carving_level.push_back(carving_level(row, col));
   };

@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "analytic_rays.hpp"
-#include "box_room_rays.hpp"
 #include "featsense/config/sensor_model.hpp"
 #include "tsdf_test_support.hpp"
 
@@ -209,27 +208,6 @@ TEST(CpuIntegrator, BadPointsAreIgnoredAndBadBatchesRejected) {
   wrong.origins_m.push_back(wrong.origins_m.front());  // two origins for many end points
   EXPECT_THROW(dirty->integrate(wrong), std::invalid_argument);
   EXPECT_EQ(dirty->integrate(RayBatch{}).rays, 0u);
-
-  RayBatch indexed = wall_scan();
-  indexed.origin_index.assign(indexed.size(), 0);
-  indexed.origin_index.back() = 1;  // names an origin the batch does not have
-  EXPECT_THROW(dirty->integrate(indexed), std::invalid_argument);
-  indexed.origin_index.pop_back();  // one index short
-  EXPECT_THROW(dirty->integrate(indexed), std::invalid_argument);
-}
-
-TEST(CpuIntegrator, OriginsIndexedPerEndPointGiveTheSameMap) {
-  // A moving sensor: one origin per end point, or each distinct origin once and an index.
-  const TsdfSettings s = test::small_map_settings();
-  const std::vector<RayBatch> scans = test::box_room_rays(2, false);
-  auto per_point = make_cpu_integrator(s, test::make_vec(-2, 0, 1.5));
-  auto indexed = make_cpu_integrator(s, test::make_vec(-2, 0, 1.5));
-  for (const RayBatch& scan : scans) {
-    const RayBatch shared = test::with_origin_index(scan);
-    ASSERT_LT(shared.origins_m.size(), scan.size() / 10);
-    EXPECT_EQ(per_point->integrate(scan).voxels_updated, indexed->integrate(shared).voxels_updated);
-  }
-  EXPECT_TRUE(per_point->download() == indexed->download());
 }
 
 }  // namespace

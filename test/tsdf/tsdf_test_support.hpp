@@ -2,34 +2,13 @@
 // Reading values out of an integrator's map in metres, for the TSDF tests.
 
 #include <functional>
-#include <map>
 #include <memory>
-#include <tuple>
-#include <utility>
 #include <vector>
 
 #include "featsense/tsdf/integrator.hpp"
-#include "featsense/tsdf/ray_batch.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
 namespace featsense::tsdf::test {
-
-/// The same rays with each distinct origin given once and indexed per end point (as a
-/// deskewed scan gives one origin per column).
-inline RayBatch with_origin_index(RayBatch rays) {
-  if (rays.origins_m.size() != rays.size()) return rays;
-  std::map<std::tuple<float, float, float>, uint16_t> index_of;
-  HostVector<Vec3> origins;
-  rays.origin_index.clear();
-  for (const Vec3& o : rays.origins_m) {
-    const auto [it, added] =
-        index_of.try_emplace({o.x, o.y, o.z}, static_cast<uint16_t>(origins.size()));
-    if (added) origins.push_back(o);
-    rays.origin_index.push_back(it->second);
-  }
-  rays.origins_m = std::move(origins);
-  return rays;
-}
 
 /// Settings for small, fast test maps: 0.1 m voxels, tau 0.4 m, 16 x 16 x 8 m.
 inline TsdfSettings small_map_settings() {

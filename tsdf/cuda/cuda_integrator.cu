@@ -162,11 +162,11 @@ __global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, const ui
 // of them) every ray of an OS1-128 scan is then walked in one wave. (A walk without the limit
 // takes 78 registers, three blocks: a second wave for the last rays.)
 __global__ void __launch_bounds__(kThreads, 4)
-    min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const uint16_t* origin_index,
-                    const Vec3* endpoints, const uint8_t* interpolate, const uint8_t* carving_level,
-                    bool carve_free_space, float dense_range_m, const uint32_t* kept,
-                    const uint32_t* kept_count, detail::RayMarchParams params,
-                    ProposeCandidate propose, const uint8_t* settled_bricks) {
+    min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
+                    const uint8_t* interpolate, const uint8_t* carving_level, bool carve_free_space,
+                    float dense_range_m, const uint32_t* kept, const uint32_t* kept_count,
+                    detail::RayMarchParams params, ProposeCandidate propose,
+                    const uint8_t* settled_bricks) {
   const uint32_t count = *kept_count;
   detail::RayMarchParams flat = params;
   flat.interpolation_slope = 0.0f;
@@ -178,8 +178,8 @@ __global__ void __launch_bounds__(kThreads, 4)
         detail::carving_start(carve_free_space, dense_range_m,
                               carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
     WalkVisitor visit{propose};
-    const uint32_t o = origin_index != nullptr ? origin_index[i] : (origin_per_point ? i : 0u);
-    detail::walk_ray(origins[o], endpoints[i], propose.map, ray, visit, settled_bricks);
+    detail::walk_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, visit,
+                     settled_bricks);
     visit.flush();
   }
 }
@@ -414,8 +414,8 @@ class CudaIntegrator final : public Integrator {
     return map_.bytes() + candidates_.bytes() + settled_.bytes() + free_space_.bytes() +
            settled_bricks_.bytes() + brick_flags_.bytes() + band_bricks_.bytes() +
            touched_bricks_.bytes() + free_bricks_.bytes() + kept_.bytes() + endpoints_.bytes() +
-           origins_.bytes() + origin_index_.bytes() + counters_.bytes() + brick_offsets_.bytes() +
-           brick_staging_.bytes() + interpolate_.bytes() + carving_level_.bytes();
+           origins_.bytes() + counters_.bytes() + brick_offsets_.bytes() + brick_staging_.bytes() +
+           interpolate_.bytes() + carving_level_.bytes();
   }
 
   std::vector<uint32_t> download() const override {
@@ -466,7 +466,8 @@ class CudaIntegrator final : public Integrator {
     IntegrationStats stats;
     if (n == 0) return stats;
     const bool origin_per_point = rays.origins_m.size() > 1;
-    upload(rays);
+    const size_t origin_count = origin_per_point ? n : 1;
+    upload(rays, origin_count);
     uint32_t* kept_count = counters_.data() + kKeptRays;
     uint32_t* touched_count = counters_.data() + kTouchedBricks;
     uint32_t* free_count = counters_.data() + kFreeBricks;
@@ -494,10 +495,9 @@ class CudaIntegrator final : public Integrator {
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
     min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
-        origins_.data(), origin_per_point,
-        rays.origin_index.empty() ? nullptr : origin_index_.data(), endpoints_.data(), interpolate,
-        carving_level, settings_.carve_free_space, settings_.dense_range_m, kept_.data(),
-        kept_count, params, propose, settled_bricks_.data());
+        origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
+        settings_.carve_free_space, settings_.dense_range_m, kept_.data(), kept_count, params,
+        propose, settled_bricks_.data());
     FEATSENSE_CUDA_CHECK(cudaGetLastError());
     const auto brick_count = static_cast<uint32_t>(geometry_.voxel_count() / kBrickVoxels);
     list_touched_bricks_kernel<<<blocks_for(brick_count), kThreads, 0, stream_>>>(
@@ -526,16 +526,12 @@ class CudaIntegrator final : public Integrator {
  private:
   enum Counter { kKeptRays, kTouchedBricks, kFreeBricks, kVoxelsUpdated, kCounters };
 
-  void upload(const RayBatch& rays) {
+  void upload(const RayBatch& rays, size_t origin_count) {
     const size_t n = rays.size();
     endpoints_.grow(n);
-    origins_.grow(rays.origins_m.size());
+    origins_.grow(origin_count);
     upload_array(endpoints_.data(), rays.endpoints_m.data(), n, endpoint_staging_);
-    upload_array(origins_.data(), rays.origins_m.data(), rays.origins_m.size(), origin_staging_);
-    if (!rays.origin_index.empty()) {
-      origin_index_.grow(n);
-      upload_array(origin_index_.data(), rays.origin_index.data(), n, origin_index_staging_);
-    }
+    upload_array(origins_.data(), rays.origins_m.data(), origin_count, origin_staging_);
     if (!rays.interpolate.empty()) {
       interpolate_.grow(n);
       upload_array(interpolate_.data(), rays.interpolate.data(), n, interpolate_staging_);
@@ -603,8 +599,6 @@ class CudaIntegrator final : public Integrator {
   cuda::DeviceBuffer<Vec3> origins_;
   cuda::PinnedBuffer<Vec3> endpoint_staging_;  ///< for end points not in page-locked memory
   cuda::PinnedBuffer<Vec3> origin_staging_;
-  cuda::DeviceBuffer<uint16_t> origin_index_;  ///< per end point, when the batch has indices
-  cuda::PinnedBuffer<uint16_t> origin_index_staging_;
   cuda::DeviceBuffer<uint8_t> interpolate_;  ///< per end point, when the batch has flags
   cuda::PinnedBuffer<uint8_t> interpolate_staging_;
   cuda::DeviceBuffer<uint8_t> carving_level_;  ///< per end point, when the batch has levels

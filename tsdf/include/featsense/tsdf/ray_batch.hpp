@@ -14,14 +14,9 @@ namespace featsense::tsdf {
 constexpr uint8_t kFullCarvingLevel = 16;
 
 struct RayBatch {
-  /// Ray origins, map frame, metres: a single one for all end points, one per end point, or,
-  /// with origin_index, any number that the end points pick from (a deskewed scan: one per
-  /// column, the sensor's position when the column was taken; a GPU then uploads a fifth of
-  /// the bytes per point less).
+  /// Ray origins, map frame, metres: one per end point (a deskewed scan: the sensor's
+  /// position when each point was taken) or a single one for all.
   HostVector<Vec3> origins_m;
-  /// Per end point, which of origins_m is its ray's origin; empty: one origin for all, or one
-  /// per end point, as origins_m's size says.
-  HostVector<uint16_t> origin_index;
   HostVector<Vec3> endpoints_m;  ///< measured points, map frame, metres
   Vec3 up{0.0f, 0.0f, 1.0f};     ///< the sensor's z axis in the map frame (unit)
   /// Per end point, 0 where the ray must not interpolate vertically (its surface is seen at
@@ -33,19 +28,15 @@ struct RayBatch {
   HostVector<uint8_t> carving_level;
 
   size_t size() const { return endpoints_m.size(); }
-  Vec3 origin(size_t i) const {
-    if (!origin_index.empty()) return origins_m[origin_index[i]];
-    return origins_m.size() == 1 ? origins_m[0] : origins_m[i];
-  }
+  Vec3 origin(size_t i) const { return origins_m.size() == 1 ? origins_m[0] : origins_m[i]; }
   bool may_interpolate(size_t i) const { return interpolate.empty() || interpolate[i] != 0; }
   uint8_t carving_level_of(size_t i) const {
     return carving_level.empty() ? kFullCarvingLevel : carving_level[i];
   }
 };
 
-/// Throws std::invalid_argument unless there is one origin, or one per end point, or an origin
-/// index per end point that names one of the origins, and the interpolation flags and carving
-/// levels are each absent or one per end point.
+/// Throws std::invalid_argument unless there is one origin, or one per end point, and the
+/// interpolation flags and carving levels are each absent or one per end point.
 void check_ray_batch(const RayBatch& rays);
 
 }  // namespace featsense::tsdf
