@@ -109,6 +109,7 @@ struct WalkVisitor {
   uint32_t word = 0xFFFFFFFFu;  // the word being gathered, none yet
   uint32_t bits = 0;
   uint32_t settled_word = 0;
+  uint32_t marked_brick = 0xFFFFFFFFu;  // the brick this walk last marked for the fusion
 
   __device__ void operator()(uint32_t index, int32_t value, bool interpolated) {
     if (value != kValueScale || interpolated) {
@@ -129,7 +130,13 @@ struct WalkVisitor {
     bits = 0;
     if (fresh == 0u) return;
     atomicOr(&propose.free_space[word], fresh);
-    propose.brick_flags[word / (kBrickVoxels / 32)] = 1u;
+    // A brick's flag stays set until the fusion: once a walk has set it, it need not again
+    // (most flushes stay in the brick of the last one).
+    const uint32_t brick = word / (kBrickVoxels / 32);
+    if (brick != marked_brick) {
+      propose.brick_flags[brick] = 1u;
+      marked_brick = brick;
+    }
   }
 };
 
