@@ -301,6 +301,45 @@ struct Visit {
   }
 };
 
+TEST(WalkClock, TicksAreClampedAndNeverDecrease) {
+  const detail::WalkClock clock{static_cast<float>(detail::kWalkTicks) / 40.0f};  // a 40 m walk
+  EXPECT_EQ(clock.ticks(std::numeric_limits<float>::quiet_NaN()), 0);
+  EXPECT_EQ(clock.ticks(-1.0f), 0);
+  EXPECT_EQ(clock.ticks(0.0f), 0);
+  EXPECT_EQ(clock.ticks(40.0f), detail::kWalkTicks);
+  EXPECT_EQ(clock.ticks(40.01f), detail::kBeyondWalk);
+  EXPECT_EQ(clock.ticks(std::numeric_limits<float>::infinity()), detail::kBeyondWalk);
+  EXPECT_EQ(clock.ticks(std::numeric_limits<float>::max()), detail::kBeyondWalk);
+  int32_t last = 0;
+  for (float t = 0.0f; t < 41.0f; t += 0.0137f) {
+    const int32_t ticks = clock.ticks(t);
+    EXPECT_GE(ticks, last) << t;
+    last = ticks;
+  }
+}
+
+TEST(WalkClock, AxisCrossingsMoveOnOrNeverCome) {
+  const float vs = 0.064f;
+  // A walk of 2 mm: the spacing of crossings is far beyond its end, clamped.
+  const detail::WalkClock short_walk{static_cast<float>(detail::kWalkTicks) / 0.002f};
+  const detail::AxisCrossings c = detail::axis_crossings(0.01f, 0.3f, 0, vs, short_walk);
+  EXPECT_EQ(c.step, 1);
+  EXPECT_EQ(c.delta, detail::kBeyondWalk);
+  // A walk along no part of the axis never crosses it.
+  const detail::WalkClock clock{static_cast<float>(detail::kWalkTicks) / 30.0f};
+  const detail::AxisCrossings parallel = detail::axis_crossings(1.0f, 0.0f, 15, vs, clock);
+  EXPECT_EQ(parallel.step, 0);
+  EXPECT_EQ(parallel.first, detail::kBeyondWalk);
+  EXPECT_EQ(parallel.delta, detail::kBeyondWalk);
+  // A steep axis: crossings a voxel apart along it, at least a tick apart whatever the slope.
+  const detail::AxisCrossings backwards = detail::axis_crossings(1.0f, -1.0f, 15, vs, clock);
+  EXPECT_EQ(backwards.step, -1);
+  EXPECT_GE(backwards.first, 0);
+  EXPECT_NEAR(static_cast<double>(backwards.delta), vs / 30.0 * detail::kWalkTicks, 2.0);
+  const detail::AxisCrossings grazing = detail::axis_crossings(1.0f, 1e-12f, 15, vs, clock);
+  EXPECT_EQ(grazing.delta, detail::kBeyondWalk);
+}
+
 TEST(CpuIntegratorExact, JumpsAcrossSettledBricksLeaveTheWalkExact) {
   // The walk both backends run jumps across bricks of settled free space. Leaving out the
   // candidates it would pass by anyway (+tau in a settled brick), it must propose what

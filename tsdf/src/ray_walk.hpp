@@ -56,6 +56,7 @@ FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3
                                     int32_t walk_end_ticks, BrickExit& exit) {
   // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
   // Ticks stay below 2^31: t_next <= 2 kBeyondWalk and t_delta <= kBeyondWalk = 2^27 + 1.
+  static_assert(int64_t{2 + kBrickSize} * kBeyondWalk < int64_t{1} << 31, "ticks overflow");
   int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
   exit.axis = -1;
   exit.t = 0;
