@@ -1,9 +1,10 @@
 // The CUDA integrator: the same rule as the CPU reference (voxel.hpp, ray_walk.hpp) in
-// five kernels per scan: keep one end point per voxel (two), the per-scan minimum (atomicMin
+// six kernels per scan: keep one end point per voxel (two), the per-scan minimum (atomicMin
 // on the ordered candidate keys; free space, whose key is always +tau, as a bit per voxel),
-// the list of touched bricks, and the fusion of their voxels with the reset of the
-// candidates. Free-space candidates pass settled free space by (voxel.hpp,
-// settled_free_voxel), found in a bit per voxel that the fusion keeps.
+// the lists of touched bricks (with candidates, and only passed in free space), and the
+// fusion of each list's voxels with the reset of the candidates and bits. Free-space
+// candidates pass settled free space by (voxel.hpp, settled_free_voxel), found in a bit per
+// voxel that the fusion keeps.
 
 #include <cuda_runtime.h>
 
