@@ -102,6 +102,24 @@ FEATSENSE_HD_INLINE AxisCrossings axis_crossings(float origin, float direction, 
   return {0, kBeyondWalk, kBeyondWalk};
 }
 
+/// The paper's vertical interpolation (eq. 7-8) around a voxel of the band: the voxels
+/// round(half_height / voxel) steps above and below its centre along `across`, those inside
+/// the map, handed to visit_voxel(global index) nearest first, above before below.
+template <typename VisitVoxel>
+FEATSENSE_HD_INLINE void for_each_interpolated_voxel(const LocalMapGeometry& map, Vec3 centre,
+                                                     Vec3 across, float half_height,
+                                                     VisitVoxel&& visit_voxel) {
+  const float vs = map.voxel_size_m;
+  const int32_t reach = static_cast<int32_t>(half_height / vs);
+  for (int32_t k = 1; k <= reach; ++k) {
+    const float shift = static_cast<float>(k) * vs;
+    const Index3 above = map.voxel_of(centre + shift * across);
+    const Index3 below = map.voxel_of(centre - shift * across);
+    if (map.contains(above)) visit_voxel(above);
+    if (map.contains(below)) visit_voxel(below);
+  }
+}
+
 /// Clips the segment origin + t * dir, t in [t0, t1], to the box [lo, hi]; false if it misses.
 FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, float& t0,
                                      float& t1) {
@@ -185,15 +203,8 @@ FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeo
         // Fill between the scan lines only near the surface: free space far in front is
         // carved by the rays themselves, and widening every ray there costs more than it gives.
         if (interpolate && distance < tau) {
-          const float half_height = params.interpolation_slope * along;
-          const int32_t reach = static_cast<int32_t>(half_height / vs);
-          for (int32_t k = 1; k <= reach; ++k) {
-            const float offset = static_cast<float>(k) * vs;
-            const Index3 above = map.voxel_of(centre + offset * across);
-            const Index3 below = map.voxel_of(centre - offset * across);
-            if (map.contains(above)) visit(map.linear(above), value, true);
-            if (map.contains(below)) visit(map.linear(below), value, true);
-          }
+          for_each_interpolated_voxel(map, centre, across, params.interpolation_slope * along,
+                                      [&](Index3 g) { visit(map.linear(g), value, true); });
         }
       }
     }

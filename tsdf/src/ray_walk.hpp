@@ -278,19 +278,10 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
             const int32_t value = distance_to_fixed(distance, tau);
             visit(index, value, false);
             if (interpolate) {
-              const float half_height = params.interpolation_slope * along;
-              const int32_t reach = static_cast<int32_t>(half_height / vs);
-              for (int32_t k = 1; k <= reach; ++k) {
-                const float shift = static_cast<float>(k) * vs;
-                const Index3 above = map.voxel_of(centre + shift * across);
-                const Index3 below = map.voxel_of(centre - shift * across);
-                if (map.contains(above)) {
-                  visit(static_cast<WalkIndex>(linear_of_contained(above)), value, true);
-                }
-                if (map.contains(below)) {
-                  visit(static_cast<WalkIndex>(linear_of_contained(below)), value, true);
-                }
-              }
+              for_each_interpolated_voxel(
+                  map, centre, across, params.interpolation_slope * along, [&](Index3 v) {
+                    visit(static_cast<WalkIndex>(linear_of_contained(v)), value, true);
+                  });
             }
           }
         }
