@@ -401,5 +401,54 @@ TEST(CpuIntegratorExact, JumpsAcrossSettledBricksLeaveTheWalkExact) {
   EXPECT_GT(jumped, 10000u);  // the jumps were taken
 }
 
+TEST(CpuIntegratorExact, AWalkInPartsVisitsWhatTheWholeWalkVisits) {
+  // The GPU walks rays in parts (WalkPart), each starting where the whole walk would be at its
+  // first tick. Together, in order, they must propose exactly what the whole walk proposes: the
+  // same sequence without settled bricks; with them, the same candidates that are not passed
+  // by (a part may start inside a settled brick and jump from there). Rays from inside and
+  // outside the map, ending inside and beyond it, with and without sparse carving.
+  TsdfSettings s;
+  const LocalMapGeometry map = centred_geometry(s, test::make_vec(0, 0, 1.5));
+  std::vector<uint8_t> settled(map.voxel_count() / kBrickVoxels);
+  std::mt19937 random(11);
+  for (uint8_t& brick : settled) brick = random() % 3 != 0 ? 1 : 0;
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  size_t visits = 0;
+  for (int k = 0; k < 300; ++k) {
+    const float reach = k % 3 == 0 ? 30.0f : 18.0f;  // the map reaches 20 m from its centre
+    const Vec3 origin = test::make_vec(reach * uniform(random), reach * uniform(random),
+                                       1.5 + 2.0f * uniform(random));
+    const Vec3 d{uniform(random), uniform(random), 0.2f * uniform(random)};
+    const Vec3 endpoint = origin + (1.0f + 30.0f * std::fabs(uniform(random))) * d;
+    detail::RayMarchParams params;
+    params.truncation_m = s.truncation_m;
+    params.interpolation_slope = k % 2 == 0 ? 0.006f : 0.0f;
+    params.carve_from_m = k % 4 == 1 ? 3.0f : 0.0f;
+    const uint8_t* const brick_sets[] = {nullptr, settled.data()};
+    for (const uint8_t* bricks : brick_sets) {
+      const auto passed_by = [&](const Visit& v) {
+        return bricks != nullptr && v.value == kValueScale && bricks[v.index / kBrickVoxels] != 0;
+      };
+      std::vector<Visit> whole;
+      const auto record = [&](std::vector<Visit>& out) {
+        return [&](size_t i, int32_t v, bool interp) {
+          if (!passed_by({i, v, interp})) out.push_back({i, v, interp});
+        };
+      };
+      detail::walk_ray(origin, endpoint, map, params, record(whole), bricks);
+      visits += whole.size();
+      for (const int32_t count : {2, 3, 7}) {
+        std::vector<Visit> parts;
+        for (int32_t index = 0; index < count; ++index) {
+          detail::walk_ray(origin, endpoint, map, params, record(parts), bricks,
+                           detail::WalkPart{index, count});
+        }
+        EXPECT_TRUE(parts == whole) << count << " parts, ray " << k << (bricks ? ", settled" : "");
+      }
+    }
+  }
+  EXPECT_GT(visits, 50000u);
+}
+
 }  // namespace
 }  // namespace featsense::tsdf

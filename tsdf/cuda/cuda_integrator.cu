@@ -166,30 +166,45 @@ __global__ void list_touched_bricks_kernel(const uint32_t* brick_flags, const ui
   append_warp_items(touched && !band, i, free_list, free_count);
 }
 
-// At most 64 registers, so that four blocks share a multiprocessor: on an H100 or H200 (132
-// of them) every ray of an OS1-128 scan is then walked in one wave. (A walk without the limit
-// takes 78 registers, three blocks: a second wave for the last rays.)
+/// Parts each ray's walk is cut into (ray_walk.hpp, WalkPart). Walks differ in length by 100x
+/// and a block's take as long as its longest, so with one block a ray's whole walk, some
+/// multiprocessors finished in 60 % of the time of the last (a scan's blocks fit on the GPU
+/// at once, so none were left to give them). In parts, the blocks are shorter and a second
+/// wave of them fills the multiprocessors that finish first.
+constexpr int32_t kWalkParts = 6;
+constexpr float kWalkPartLength = 4.0f;  ///< metres
+
+// At most 64 registers, so that four blocks share a multiprocessor. (A walk without the limit
+// takes 78 registers, three blocks.)
 __global__ void __launch_bounds__(kThreads, 4)
     min_tsdf_kernel(const Vec3* origins, bool origin_per_point, const Vec3* endpoints,
                     const uint8_t* interpolate, const uint8_t* carving_level, bool carve_free_space,
                     float dense_range_m, const uint32_t* kept, const uint32_t* kept_count,
                     detail::RayMarchParams params, ProposeCandidate propose,
                     const uint8_t* settled_bricks) {
-  const uint32_t count = *kept_count;
-  detail::RayMarchParams flat = params;
-  flat.interpolation_slope = 0.0f;
-  for (uint32_t k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
-    const uint32_t i = kept[k];
-    const bool may_interpolate = interpolate == nullptr || interpolate[i] != 0;
-    detail::RayMarchParams ray = may_interpolate ? params : flat;
-    ray.carve_from_m =
-        detail::carving_start(carve_free_space, dense_range_m,
-                              carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
-    WalkVisitor visit{propose};
-    detail::walk_ray(origins[origin_per_point ? i : 0], endpoints[i], propose.map, ray, visit,
-                     settled_bricks);
-    visit.flush();
-  }
+  // Block b walks part b % kWalkParts of the rays of block b / kWalkParts: the parts of a
+  // ray are walked at about the same time, by neighbouring blocks.
+  const uint32_t k = blockIdx.x / static_cast<uint32_t>(kWalkParts) * blockDim.x + threadIdx.x;
+  if (k >= *kept_count) return;
+  const uint32_t i = kept[k];
+  const Vec3 origin = origins[origin_per_point ? i : 0];
+  // A ray is cut into one part per kWalkPartLength of its length, at most kWalkParts: the
+  // shorter ones need not pay for setting up parts they hardly need.
+  const float length = norm(endpoints[i] - origin);
+  const float wanted = length / kWalkPartLength;
+  const int32_t count =
+      wanted < static_cast<float>(kWalkParts) ? 1 + static_cast<int32_t>(wanted) : kWalkParts;
+  const detail::WalkPart part{static_cast<int32_t>(blockIdx.x % static_cast<uint32_t>(kWalkParts)),
+                              count};
+  if (part.index >= part.count) return;
+  detail::RayMarchParams ray = params;
+  if (interpolate != nullptr && interpolate[i] == 0) ray.interpolation_slope = 0.0f;
+  ray.carve_from_m =
+      detail::carving_start(carve_free_space, dense_range_m,
+                            carving_level == nullptr ? kFullCarvingLevel : carving_level[i]);
+  WalkVisitor visit{propose};
+  detail::walk_ray(origin, endpoints[i], propose.map, ray, visit, settled_bricks, part);
+  visit.flush();
 }
 
 /// A brick's voxels as a warp fuses them: 16 rounds of 32 consecutive voxels, lane l taking
@@ -502,7 +517,7 @@ class CudaIntegrator final : public Integrator {
                                    band_bricks_.data(), settled_.data(),    free_space_.data()};
     const uint8_t* interpolate = rays.interpolate.empty() ? nullptr : interpolate_.data();
     const uint8_t* carving_level = rays.carving_level.empty() ? nullptr : carving_level_.data();
-    min_tsdf_kernel<<<blocks_for(n), kThreads, 0, stream_>>>(
+    min_tsdf_kernel<<<blocks_for(n) * static_cast<unsigned int>(kWalkParts), kThreads, 0, stream_>>>(
         origins_.data(), origin_per_point, endpoints_.data(), interpolate, carving_level,
         settings_.carve_free_space, settings_.dense_range_m, kept_.data(), kept_count, params,
         propose, settled_bricks_.data());

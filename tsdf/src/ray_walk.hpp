@@ -24,16 +24,6 @@
 
 namespace featsense::tsdf::detail {
 
-/// Along one axis, a step of `step` (+-1) that left the brick: the place in the brick moves to
-/// the near side of the next brick, whose ring-buffer slot wraps around `bricks` slots.
-FEATSENSE_HD_INLINE void enter_next_brick(int32_t& local, int32_t& brick, int32_t step,
-                                          int32_t bricks) {
-  local -= step * kBrickSize;
-  brick += step;
-  if (brick == bricks) brick = 0;
-  if (brick < 0) brick = bricks - 1;
-}
-
 /// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
 struct BrickExit {
   int axis;            ///< the axis whose crossing leaves the brick
@@ -47,13 +37,12 @@ struct BrickExit {
 /// t, the lower axis first on ties (the rule of the walk's step), and an axis's crossings are
 /// t_next + j * t_delta in exact integer ticks (WalkClock), so the state is exactly the one that
 /// stepping voxel by voxel reaches. A brick all of whose voxels would pass every candidate by
-/// can so be crossed in one jump. False where the walk ends (t > walk_end_ticks) before the
-/// exit.
+/// can so be crossed in one jump. False where no axis is stepped along.
 /// Nothing depends on an earlier result but the exit itself, and no loop's length on the
 /// lane, so on the GPU a warp's jumping lanes run one short code path together.
 FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
                                     const int32_t t_next[3], const int32_t t_delta[3],
-                                    int32_t walk_end_ticks, BrickExit& exit) {
+                                    BrickExit& exit) {
   // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
   // Ticks stay below 2^31: t_next <= 2 kBeyondWalk and t_delta <= kBeyondWalk = 2^27 + 1.
   static_assert(int64_t{2 + kBrickSize} * kBeyondWalk < int64_t{1} << 31, "ticks overflow");
@@ -69,7 +58,7 @@ FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3
       exit.t = t_out;
     }
   }
-  if (exit.axis < 0 || exit.t > walk_end_ticks) return false;
+  if (exit.axis < 0) return false;
   for (int axis = 0; axis < 3; ++axis) {
     int32_t crossed = 0;
     if (axis == exit.axis) {
@@ -105,13 +94,24 @@ using WalkIndex = uint32_t;
 using WalkIndex = int64_t;
 #endif
 
+/// One of `count` parts of a walk, which together make the whole walk: part k takes the
+/// voxels entered from k / count of the walk's ticks on (up to the next part's). A walk's state
+/// at any tick follows from its crossings (first + j * delta, exact), so a part starts where
+/// the whole walk would be there, and visits what it would visit. The GPU walks long rays in
+/// parts, so that its multiprocessors share the work evenly.
+struct WalkPart {
+  int32_t index = 0;
+  int32_t count = 1;
+};
+
 /// Calls visit(linear_index, value_fixed, interpolated) for every candidate march_ray would
 /// propose for this ray, in the same order, except the free-space candidates of the bricks
-/// that `settled_bricks` (nonzero per brick slot, or null) names as settled free space.
+/// that `settled_bricks` (nonzero per brick slot, or null) names as settled free space; only
+/// those of `part` of the walk.
 template <typename Visit>
 FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
                                   const RayMarchParams& params, Visit&& visit,
-                                  const uint8_t* settled_bricks = nullptr) {
+                                  const uint8_t* settled_bricks = nullptr, WalkPart part = {}) {
   const Vec3 delta = endpoint - origin;
   const float range = norm(delta);
   if (!(range > 0.0f && range < 1.0e30f)) return;
@@ -134,46 +134,88 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   const Index3 start = map.voxel_of(walk_start);
   const Index3 start_brick = map.wrapped_brick(start);
   const Index3 start_local = LocalMapGeometry::local_in_brick(start);
-  const Index3 nb = map.bricks();
 
   int32_t step[3] = {};
   int32_t t_next[3] = {};  // ticks (WalkClock)
   int32_t t_delta[3] = {};
   int32_t offset[3] = {};  // global index less the map's lowest corner: inside when in [0, dim)
-  int32_t dim[3] = {};     // voxels per axis
-  int32_t brick[3] = {};   // ring-buffer slot coordinates of the current brick
-  int32_t local[3] = {};   // place in the brick
-  int32_t bricks[3] = {};  // bricks per axis
+  int32_t dim[3] = {};     // voxels per axis, of the map and of its ring buffer
+  // The voxel's place in the ring buffer: its brick slot * kBrickSize + its place in the brick,
+  // in [0, dim). The storage index follows from it (storage_index); where a step leaves the
+  // ring buffer, it wraps around by one comparison.
+  int32_t ring[3] = {};
+  int32_t crossings = 0;  // face crossings up to the walk's end
   for (int axis = 0; axis < 3; ++axis) {
     const int32_t v = component(start, axis);
     const AxisCrossings c =
         axis_crossings(component(walk_start, axis), component(walk_dir, axis), v, vs, clock);
     step[axis] = c.step;
-    t_next[axis] = c.first;
+    // An axis the walk runs parallel to is never stepped along: its crossing never comes.
+    t_next[axis] = c.step != 0 ? c.first : INT32_MAX;
     t_delta[axis] = c.delta;
+    if (c.step != 0 && c.first <= walk_end_ticks) {
+      crossings += (walk_end_ticks - c.first) / c.delta + 1;
+    }
     offset[axis] = v - component(map.origin, axis);
     dim[axis] = component(map.dim, axis);
-    brick[axis] = component(start_brick, axis);
-    local[axis] = component(start_local, axis);
-    bricks[axis] = component(nb, axis);
+    ring[axis] = component(start_brick, axis) * kBrickSize + component(start_local, axis);
   }
-  const auto linear = [&] {
-    return map.linear_from({brick[0], brick[1], brick[2]}, {local[0], local[1], local[2]});
-  };
-  // Storage strides of one step inside a brick, per axis.
-  const WalkIndex local_stride[3] = {1, kBrickSize, kBrickSize * kBrickSize};
-  WalkIndex index = static_cast<WalkIndex>(linear());
-  // Storage distance between neighbouring brick slots along an axis. Computed where needed,
-  // from registers the walk holds anyway.
-  const auto slot_stride = [&](auto axis_constant) -> WalkIndex {
-    constexpr int axis = decltype(axis_constant)::value;
-    return static_cast<WalkIndex>(kBrickVoxels) * static_cast<WalkIndex>(axis > 0 ? bricks[0] : 1) *
-           static_cast<WalkIndex>(axis > 1 ? bricks[1] : 1);
+  // The walk's turns: its first voxel, then one a crossing up to its end (crossings come in the
+  // order of their t, so counting them ends the walk where t passes the end). Bounded by the
+  // voxels a segment can cross, so rounding can never loop forever.
+  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
+  const int32_t turns = crossings + 1 < max_steps ? crossings + 1 : max_steps;
+
+  // The part's turns: from the first whose voxel is entered at its first tick, up to the next
+  // part's first. Turn i visits the voxel reached by the walk's first i crossings.
+  int32_t t = 0;  // the tick of the last crossing, where the current voxel was entered
+  int32_t first_turn = 0;
+  int32_t end_turn = turns;
+  if (part.count > 1) {
+    const auto part_start = [&](int32_t k) {
+      return static_cast<int32_t>(static_cast<int64_t>(walk_end_ticks) * k / part.count);
+    };
+    const auto crossings_before = [&](int axis, int32_t tick) {  // those with t < tick
+      return step[axis] == 0 || tick <= t_next[axis]
+                 ? 0
+                 : (tick - 1 - t_next[axis]) / t_delta[axis] + 1;
+    };
+    if (part.index + 1 < part.count) {
+      const int32_t end = part_start(part.index + 1);
+      const int32_t before =
+          crossings_before(0, end) + crossings_before(1, end) + crossings_before(2, end);
+      end_turn = before < turns ? before : turns;
+    }
+    const int32_t begin = part_start(part.index);
+    for (int axis = 0; axis < 3; ++axis) {  // the state after the crossings before `begin`
+      const int32_t crossed = crossings_before(axis, begin);
+      if (crossed == 0) continue;
+      const int32_t last = t_next[axis] + (crossed - 1) * t_delta[axis];
+      t = last > t ? last : t;
+      t_next[axis] = last + t_delta[axis];
+      offset[axis] += step[axis] * crossed;
+      ring[axis] = (ring[axis] + step[axis] * crossed) % dim[axis];
+      if (ring[axis] < 0) ring[axis] += dim[axis];
+      first_turn += crossed;
+    }
+    if (first_turn >= end_turn) return;
+  }
+  // map.linear_from for the place in the ring buffer, in WalkIndex arithmetic.
+  const auto storage_index = [&] {
+    const auto slot = [&](int axis) { return static_cast<WalkIndex>(ring[axis] >> kBrickShift); };
+    const auto place = [&](int axis) {
+      return static_cast<WalkIndex>(ring[axis] & (kBrickSize - 1));
+    };
+    const WalkIndex bricks_x = static_cast<WalkIndex>(dim[0] >> kBrickShift);
+    const WalkIndex bricks_y = static_cast<WalkIndex>(dim[1] >> kBrickShift);
+    return ((slot(2) * bricks_y + slot(1)) * bricks_x + slot(0)) * kBrickVoxels +
+           (place(2) * kBrickSize + place(1)) * kBrickSize + place(0);
   };
 
   // map.linear for a voxel known to lie in the map, without its three divisions: the brick's
   // offset from the map's lowest brick is below the brick count, so wrapping it is one
   // comparison (the map's lowest corner is a whole brick, so the place in the brick is too).
+  const Index3 nb = map.bricks();
   const Index3 lowest_slot = map.wrapped_brick(map.origin);
   const auto linear_of_contained = [&](Index3 g) {
     const auto slot = [](int32_t relative, int32_t lowest, int32_t count) {
@@ -187,61 +229,80 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   };
 
   const float tau = params.truncation_m;
-  int32_t t = 0;
 
   const int32_t free_from = clock.ticks(free_space_from(t1, range, tau, vs));
   // Jumps from the current voxel to the first one after its brick (brick_exit). Returns the
-  // steps taken, or -1 where the walk ends before it leaves the brick.
+  // steps taken (-1: none possible).
   const auto leave_brick = [&]() -> int32_t {
+    const int32_t place[3] = {ring[0] & (kBrickSize - 1), ring[1] & (kBrickSize - 1),
+                              ring[2] & (kBrickSize - 1)};
     BrickExit exit;
-    if (!brick_exit(step, local, t_next, t_delta, walk_end_ticks, exit)) return -1;
+    if (!brick_exit(step, place, t_next, t_delta, exit)) return -1;
     for (int axis = 0; axis < 3; ++axis) {
       const int32_t moved = step[axis] * exit.crossed[axis];
       t_next[axis] = exit.t_next[axis];
       offset[axis] += moved;
-      local[axis] += moved;
+      ring[axis] += moved;
+      if (ring[axis] >= dim[axis]) ring[axis] -= dim[axis];
+      if (ring[axis] < 0) ring[axis] += dim[axis];
     }
     t = exit.t;
-    for (int axis = 0; axis < 3; ++axis) {  // constant indices keep the arrays in registers
-      if (axis == exit.axis) enter_next_brick(local[axis], brick[axis], step[axis], bricks[axis]);
-    }
-    index = static_cast<WalkIndex>(linear());
     return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
   };
 
-  // Whether the brick just entered is settled free space: loaded as the walk enters it and
-  // looked at in the next turn, so that the load's latency passes while the step finishes
-  // (the storage index is always in the ring buffer, outside the map too).
+  // The storage index, and the brick it lies in. A brick's settled flag is loaded as the walk
+  // enters it and looked at in the next turn, so that the load's latency passes while the step
+  // finishes (the storage index is always in the ring buffer, outside the map too).
+  WalkIndex index = storage_index();
+  WalkIndex brick = index / kBrickVoxels;
   const auto settled_flag = [&] {
-    return settled_bricks != nullptr ? settled_bricks[index / kBrickVoxels] : uint8_t{0};
+    return settled_bricks != nullptr ? settled_bricks[brick] : uint8_t{0};
   };
   bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
   uint8_t brick_settled = settled_flag();
-  // A step along `axis` if `taken` (every axis is passed through, so that on the GPU the
-  // untaken ones are selects, not branches). Crossing a brick face moves the storage index
-  // to the neighbouring brick slot by constants, wrapping around the ring buffer.
+  const auto enter_brick = [&] {
+    brick = index / kBrickVoxels;
+    new_brick = settled_bricks != nullptr;
+    brick_settled = settled_flag();
+  };
+  // Where the walk is in the ring buffer is what decides the storage index. The GPU computes the
+  // index from it after every step: a dozen instructions that a warp's lanes run together,
+  // where code for the step out of a brick, taken by a few lanes at a time, made the warp wait
+  // (a fifth of the walk's instructions). The CPU moves the index along with the step, and
+  // computes it only where a step leaves the brick (one step in eight; computing it at every
+  // step made the CPU's walk 10 % slower).
   const auto advance = [&](bool taken, auto axis_constant) {
     constexpr int axis = decltype(axis_constant)::value;
     const int32_t s = taken ? step[axis] : 0;
     if (taken) t = t_next[axis];
     t_next[axis] = taken ? t_next[axis] + t_delta[axis] : t_next[axis];
     offset[axis] += s;
-    local[axis] += s;
-    index += static_cast<WalkIndex>(s) * local_stride[axis];
-    if (static_cast<uint32_t>(local[axis]) >= static_cast<uint32_t>(kBrickSize)) {
-      // To the near side of the next brick slot (wrapping around the ring buffer): the index
-      // moves by the slots passed and back across the brick's width.
-      const int32_t old_brick = brick[axis];
-      enter_next_brick(local[axis], brick[axis], s, bricks[axis]);
-      index += static_cast<WalkIndex>(brick[axis] - old_brick) * slot_stride(axis_constant) -
-               static_cast<WalkIndex>(s * kBrickSize) * local_stride[axis];
-      new_brick = settled_bricks != nullptr;
-      brick_settled = settled_flag();
+    const int32_t before = ring[axis];
+    ring[axis] += s;
+    // Off either end of the ring buffer (-1 or dim): around to the other.
+    const auto wrap = [&] {
+      if (static_cast<uint32_t>(ring[axis]) >= static_cast<uint32_t>(dim[axis])) {
+        ring[axis] -= s * dim[axis];
+      }
+    };
+#ifdef __CUDA_ARCH__
+    static_cast<void>(before);
+    wrap();
+#else
+    constexpr WalkIndex local_stride = axis == 0   ? 1
+                                       : axis == 1 ? kBrickSize
+                                                   : kBrickVoxels / kBrickSize;
+    // Into the next brick slot (also where the ring buffer wraps: -1 and dim lie outside it).
+    if (((before ^ ring[axis]) >> kBrickShift) != 0) {
+      wrap();
+      index = storage_index();
+      enter_brick();
+    } else {
+      index += static_cast<WalkIndex>(s) * local_stride;
     }
+#endif
   };
-
-  const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  for (int32_t i = 0; i < max_steps && t <= walk_end_ticks; ++i) {
+  for (int32_t i = first_turn; i < end_turn; ++i) {
     const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
                         static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
                         static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
@@ -258,10 +319,10 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     // warp then meet again at the end of every turn.
     if (jump) {
       const int32_t taken = leave_brick();
-      if (taken < 0 || i + taken >= max_steps) break;
-      i += taken - 1;  // the loop adds the last one
-      new_brick = true;
-      brick_settled = settled_flag();
+      if (taken < 0 || i + taken >= end_turn) break;  // the part ends in this brick
+      i += taken - 1;                                 // the loop adds the last one
+      index = storage_index();
+      enter_brick();
     } else {
       if (inside) {
         if (in_free_space) {
@@ -308,6 +369,10 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       } else {
         advance(true, x);
       }
+#endif
+#ifdef __CUDA_ARCH__
+      index = storage_index();  // the GPU's, after every step (advance)
+      if (index / kBrickVoxels != brick) enter_brick();
 #endif
     }
   }
