@@ -132,18 +132,16 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   const WalkClock clock{static_cast<float>(kWalkTicks) / t1};
   const int32_t walk_end_ticks = clock.ticks(walk_length);
   const Index3 start = map.voxel_of(walk_start);
-  const Index3 start_brick = map.wrapped_brick(start);
-  const Index3 start_local = LocalMapGeometry::local_in_brick(start);
+  const Index3 nb = map.bricks();
+  const Index3 lowest_slot = map.wrapped_brick(map.origin);
 
   int32_t step[3] = {};
   int32_t t_next[3] = {};  // ticks (WalkClock)
   int32_t t_delta[3] = {};
   int32_t offset[3] = {};  // global index less the map's lowest corner: inside when in [0, dim)
   int32_t dim[3] = {};     // voxels per axis, of the map and of its ring buffer
-  // The voxel's place in the ring buffer: its brick slot * kBrickSize + its place in the brick,
-  // in [0, dim). The storage index follows from it (storage_index); where a step leaves the
-  // ring buffer, it wraps around by one comparison.
-  int32_t ring[3] = {};
+  // Where offset 0 lies in the ring buffer: the slot of the map's lowest brick * kBrickSize.
+  int32_t base[3] = {};
   int32_t crossings = 0;  // face crossings up to the walk's end
   for (int axis = 0; axis < 3; ++axis) {
     const int32_t v = component(start, axis);
@@ -158,7 +156,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     }
     offset[axis] = v - component(map.origin, axis);
     dim[axis] = component(map.dim, axis);
-    ring[axis] = component(start_brick, axis) * kBrickSize + component(start_local, axis);
+    base[axis] = component(lowest_slot, axis) * kBrickSize;
   }
   // The walk's turns: its first voxel, then one a crossing up to its end (crossings come in the
   // order of their t, so counting them ends the walk where t passes the end). Bounded by the
@@ -194,29 +192,37 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       t = last > t ? last : t;
       t_next[axis] = last + t_delta[axis];
       offset[axis] += step[axis] * crossed;
-      ring[axis] = (ring[axis] + step[axis] * crossed) % dim[axis];
-      if (ring[axis] < 0) ring[axis] += dim[axis];
       first_turn += crossed;
     }
     if (first_turn >= end_turn) return;
   }
-  // map.linear_from for the place in the ring buffer, in WalkIndex arithmetic.
+  // map.linear of the current voxel, from its offset, in WalkIndex arithmetic: a voxel of the
+  // map lies at base + offset in the ring buffer, less its length where that passes the end
+  // (the map's lowest corner is a whole brick, so the place in the brick is the offset's).
+  // Meaningful inside the map only: nothing outside it is visited or loaded.
   const auto storage_index = [&] {
-    const auto slot = [&](int axis) { return static_cast<WalkIndex>(ring[axis] >> kBrickShift); };
+    const auto slot = [&](int axis) {
+      const int32_t b = (base[axis] + offset[axis]) >> kBrickShift;
+      const int32_t bricks = dim[axis] >> kBrickShift;
+      return static_cast<WalkIndex>(b >= bricks ? b - bricks : b);
+    };
     const auto place = [&](int axis) {
-      return static_cast<WalkIndex>(ring[axis] & (kBrickSize - 1));
+      return static_cast<WalkIndex>(offset[axis] & (kBrickSize - 1));
     };
     const WalkIndex bricks_x = static_cast<WalkIndex>(dim[0] >> kBrickShift);
     const WalkIndex bricks_y = static_cast<WalkIndex>(dim[1] >> kBrickShift);
     return ((slot(2) * bricks_y + slot(1)) * bricks_x + slot(0)) * kBrickVoxels +
            (place(2) * kBrickSize + place(1)) * kBrickSize + place(0);
   };
+  const auto contains = [&] {
+    return static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
+           static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
+           static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
+  };
 
   // map.linear for a voxel known to lie in the map, without its three divisions: the brick's
   // offset from the map's lowest brick is below the brick count, so wrapping it is one
   // comparison (the map's lowest corner is a whole brick, so the place in the brick is too).
-  const Index3 nb = map.bricks();
-  const Index3 lowest_slot = map.wrapped_brick(map.origin);
   const auto linear_of_contained = [&](Index3 g) {
     const auto slot = [](int32_t relative, int32_t lowest, int32_t count) {
       const int32_t b = lowest + (relative >> kBrickShift);
@@ -234,29 +240,27 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   // Jumps from the current voxel to the first one after its brick (brick_exit). Returns the
   // steps taken (-1: none possible).
   const auto leave_brick = [&]() -> int32_t {
-    const int32_t place[3] = {ring[0] & (kBrickSize - 1), ring[1] & (kBrickSize - 1),
-                              ring[2] & (kBrickSize - 1)};
+    const int32_t place[3] = {offset[0] & (kBrickSize - 1), offset[1] & (kBrickSize - 1),
+                              offset[2] & (kBrickSize - 1)};
     BrickExit exit;
     if (!brick_exit(step, place, t_next, t_delta, exit)) return -1;
     for (int axis = 0; axis < 3; ++axis) {
       const int32_t moved = step[axis] * exit.crossed[axis];
       t_next[axis] = exit.t_next[axis];
       offset[axis] += moved;
-      ring[axis] += moved;
-      if (ring[axis] >= dim[axis]) ring[axis] -= dim[axis];
-      if (ring[axis] < 0) ring[axis] += dim[axis];
     }
     t = exit.t;
     return exit.crossed[0] + exit.crossed[1] + exit.crossed[2];
   };
 
-  // The storage index, and the brick it lies in. A brick's settled flag is loaded as the walk
-  // enters it and looked at in the next turn, so that the load's latency passes while the step
-  // finishes (the storage index is always in the ring buffer, outside the map too).
+  // Whether the voxel lies in the map, its storage index, and the brick it lies in. A brick's
+  // settled flag is loaded as the walk enters it and looked at in the next turn, so that the
+  // load's latency passes while the step finishes.
+  bool inside = contains();
   WalkIndex index = storage_index();
   WalkIndex brick = index / kBrickVoxels;
   const auto settled_flag = [&] {
-    return settled_bricks != nullptr ? settled_bricks[brick] : uint8_t{0};
+    return settled_bricks != nullptr && inside ? settled_bricks[brick] : uint8_t{0};
   };
   bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
   uint8_t brick_settled = settled_flag();
@@ -265,36 +269,24 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     new_brick = settled_bricks != nullptr;
     brick_settled = settled_flag();
   };
-  // Where the walk is in the ring buffer is what decides the storage index. The GPU computes the
-  // index from it after every step: a dozen instructions that a warp's lanes run together,
-  // where code for the step out of a brick, taken by a few lanes at a time, made the warp wait
-  // (a fifth of the walk's instructions). The CPU moves the index along with the step, and
-  // computes it only where a step leaves the brick (one step in eight; computing it at every
-  // step made the CPU's walk 10 % slower).
+  // The GPU computes the storage index from the offset after every step: a dozen instructions
+  // that a warp's lanes run together, where code for the step out of a brick, taken by a few
+  // lanes at a time, made the warp wait (a fifth of the walk's instructions). The CPU moves the
+  // index along with the step, and computes it only where a step leaves the brick (one step in
+  // eight; computing it at every step made the CPU's walk 10 % slower); the walk can leave or
+  // enter the map only there too (the map is whole bricks).
   const auto advance = [&](bool taken, auto axis_constant) {
     constexpr int axis = decltype(axis_constant)::value;
     const int32_t s = taken ? step[axis] : 0;
     if (taken) t = t_next[axis];
     t_next[axis] = taken ? t_next[axis] + t_delta[axis] : t_next[axis];
     offset[axis] += s;
-    const int32_t before = ring[axis];
-    ring[axis] += s;
-    // Off either end of the ring buffer (-1 or dim): around to the other.
-    const auto wrap = [&] {
-      if (static_cast<uint32_t>(ring[axis]) >= static_cast<uint32_t>(dim[axis])) {
-        ring[axis] -= s * dim[axis];
-      }
-    };
-#ifdef __CUDA_ARCH__
-    static_cast<void>(before);
-    wrap();
-#else
+#ifndef __CUDA_ARCH__
     constexpr WalkIndex local_stride = axis == 0   ? 1
                                        : axis == 1 ? kBrickSize
                                                    : kBrickVoxels / kBrickSize;
-    // Into the next brick slot (also where the ring buffer wraps: -1 and dim lie outside it).
-    if (((before ^ ring[axis]) >> kBrickShift) != 0) {
-      wrap();
+    if ((((offset[axis] - s) ^ offset[axis]) >> kBrickShift) != 0) {  // into the next brick
+      inside = contains();
       index = storage_index();
       enter_brick();
     } else {
@@ -303,9 +295,6 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
 #endif
   };
   for (int32_t i = first_turn; i < end_turn; ++i) {
-    const bool inside = static_cast<uint32_t>(offset[0]) < static_cast<uint32_t>(dim[0]) &&
-                        static_cast<uint32_t>(offset[1]) < static_cast<uint32_t>(dim[1]) &&
-                        static_cast<uint32_t>(offset[2]) < static_cast<uint32_t>(dim[2]);
     // From free_from on, every voxel is free space (free_space_from): march_ray's distance
     // there is always >= tau, so it is not computed.
     const bool in_free_space = t >= free_from;
@@ -321,6 +310,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       const int32_t taken = leave_brick();
       if (taken < 0 || i + taken >= end_turn) break;  // the part ends in this brick
       i += taken - 1;                                 // the loop adds the last one
+      inside = contains();
       index = storage_index();
       enter_brick();
     } else {
@@ -371,7 +361,8 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       }
 #endif
 #ifdef __CUDA_ARCH__
-      index = storage_index();  // the GPU's, after every step (advance)
+      inside = contains();  // the GPU's, after every step (advance)
+      index = storage_index();
       if (index / kBrickVoxels != brick) enter_brick();
 #endif
     }
