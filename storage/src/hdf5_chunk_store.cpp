@@ -207,9 +207,8 @@ void Hdf5ChunkStore::evict_if_needed() {
     if (cache_.at(key).dirty) dirty.push_back(key);
   journal_chunks(dirty);
   for (const ChunkKey& key : victims) {
-    auto it = cache_.find(key);
-    lru_.erase(it->second.lru);
-    cache_.erase(it);
+    lru_.erase(cache_.at(key).lru);
+    cache_.erase(key);
   }
 }
 
