@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <set>
 #include <unordered_set>
 
 #include "analytic_rays.hpp"
@@ -401,6 +402,15 @@ TEST(CpuIntegratorExact, JumpsAcrossSettledBricksLeaveTheWalkExact) {
   EXPECT_GT(jumped, 10000u);  // the jumps were taken
 }
 
+/// A walk's parameters: tau, the interpolation slope (0: none), sparse carving from (0: none).
+detail::RayMarchParams varied_params(float truncation_m, float slope, float carve_from_m) {
+  detail::RayMarchParams params;
+  params.truncation_m = truncation_m;
+  params.interpolation_slope = slope;
+  params.carve_from_m = carve_from_m;
+  return params;
+}
+
 TEST(CpuIntegratorExact, AWalkInPartsVisitsWhatTheWholeWalkVisits) {
   // The GPU walks rays in parts (WalkPart), each starting where the whole walk would be at its
   // first tick. Together, in order, they must propose exactly what the whole walk proposes: the
@@ -420,10 +430,8 @@ TEST(CpuIntegratorExact, AWalkInPartsVisitsWhatTheWholeWalkVisits) {
                                        1.5 + 2.0f * uniform(random));
     const Vec3 d{uniform(random), uniform(random), 0.2f * uniform(random)};
     const Vec3 endpoint = origin + (1.0f + 30.0f * std::fabs(uniform(random))) * d;
-    detail::RayMarchParams params;
-    params.truncation_m = s.truncation_m;
-    params.interpolation_slope = k % 2 == 0 ? 0.006f : 0.0f;
-    params.carve_from_m = k % 4 == 1 ? 3.0f : 0.0f;
+    const detail::RayMarchParams params =
+        varied_params(s.truncation_m, k % 2 == 0 ? 0.006f : 0.0f, k % 4 == 1 ? 3.0f : 0.0f);
     const uint8_t* const brick_sets[] = {nullptr, settled.data()};
     for (const uint8_t* bricks : brick_sets) {
       const auto passed_by = [&](const Visit& v) {
@@ -448,6 +456,94 @@ TEST(CpuIntegratorExact, AWalkInPartsVisitsWhatTheWholeWalkVisits) {
     }
   }
   EXPECT_GT(visits, 50000u);
+}
+
+/// What a walk proposes: the free space as a set, the rest in order.
+struct Proposals {
+  std::set<size_t> free;
+  std::vector<Visit> other;
+  size_t words = 0;  // free space handed over as words
+};
+
+/// A visitor that takes free space as words (kTakesFreeWords), as the CPU integrator's does,
+/// leaving out what settled bricks pass by; march_ray, which hands it every voxel on its own,
+/// is recorded with the same visitor.
+struct FreeWordVisitor {
+  static constexpr bool kTakesFreeWords = true;
+  Proposals* out;
+  const uint8_t* bricks;
+  void operator()(size_t index, int32_t value, bool interpolated) {
+    if (value == kValueScale && !interpolated) {
+      free(index);
+    } else {
+      out->other.push_back({index, value, interpolated});
+    }
+  }
+  void free_word(size_t word, uint64_t bits) {
+    ++out->words;
+    for (; bits != 0; bits &= bits - 1)
+      free(word * 64 + static_cast<size_t>(__builtin_ctzll(bits)));
+  }
+  void free(size_t index) {
+    if (bricks == nullptr || bricks[index / kBrickVoxels] == 0) out->free.insert(index);
+  }
+};
+
+TEST(CpuIntegratorExact, FreeSpaceWalkedAsWordsIsTheWalksFreeSpace) {
+  // Where a visitor takes free space as words, the CPU walks the free space at the end of a
+  // walk in a loop of its own (free_space_walk.hpp). The free space it proposes must be exactly
+  // the set march_ray proposes (less what settled bricks pass by), and every other candidate
+  // the same, in the same order. Rays along diagonals from brick corners tie at every
+  // crossing; steep rays step along z most; rays from outside the map, ending beyond it, with
+  // sparse carving, with and without settled bricks.
+  TsdfSettings s;
+  const LocalMapGeometry map = centred_geometry(s, test::make_vec(0, 0, 1.5));
+  std::vector<uint8_t> settled(map.voxel_count() / kBrickVoxels);
+  std::mt19937 random(13);
+  for (uint8_t& brick : settled) brick = random() % 3 == 0 ? 1 : 0;
+
+  std::vector<std::pair<Vec3, Vec3>> rays;  // origin, end point
+  const float corner = 8 * s.voxel_size_m;
+  for (const Vec3 origin : {test::make_vec(0, 0, 0), test::make_vec(corner, corner, corner),
+                            test::make_vec(0.01, -0.02, 1.5)}) {
+    for (const Vec3 d :
+         {test::make_vec(1, 1, 0), test::make_vec(-1, 1, 0), test::make_vec(1, 1, 1),
+          test::make_vec(-1, -1, -1), test::make_vec(1, 0, 0), test::make_vec(0, -1, 0.5),
+          test::make_vec(0.1, 0.2, -1), test::make_vec(1, 2, 0), test::make_vec(2, -1, 2)}) {
+      rays.emplace_back(origin, origin + (5.5f / norm(d)) * d);
+    }
+  }
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  for (int k = 0; k < 600; ++k) {
+    const float reach = k % 5 == 0 ? 28.0f : 15.0f;  // the map reaches 20 m from its centre
+    const Vec3 origin = test::make_vec(reach * uniform(random), reach * uniform(random),
+                                       1.5 + 2.0f * uniform(random));
+    const float steepness = k % 4 == 0 ? 2.0f : 0.3f;
+    const Vec3 d{uniform(random), uniform(random), steepness * uniform(random)};
+    rays.emplace_back(origin, origin + (1.0f + 25.0f * std::fabs(uniform(random))) * d);
+  }
+
+  size_t free_voxels = 0;
+  size_t words = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    const auto& [origin, endpoint] = rays[k];
+    const detail::RayMarchParams params =
+        varied_params(s.truncation_m, k % 2 == 0 ? 0.006f : 0.0f, k % 3 == 1 ? 2.5f : 0.0f);
+    const uint8_t* const brick_sets[] = {nullptr, settled.data()};
+    for (const uint8_t* bricks : brick_sets) {
+      Proposals reference;
+      Proposals walk;
+      detail::march_ray(origin, endpoint, map, params, FreeWordVisitor{&reference, bricks});
+      FreeWordVisitor visitor{&walk, bricks};
+      detail::walk_ray(origin, endpoint, map, params, visitor, bricks);
+      free_voxels += reference.free.size();
+      words += walk.words;
+      EXPECT_TRUE(walk.free == reference.free) << "ray " << k << (bricks ? ", settled" : "");
+      EXPECT_TRUE(walk.other == reference.other) << "ray " << k << (bricks ? ", settled" : "");
+    }
+  }
+  EXPECT_GT(free_voxels, 100000u);
+  EXPECT_GT(words, 10000u);  // the free space was walked as words
 }
 
 }  // namespace

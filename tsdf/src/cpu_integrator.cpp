@@ -358,6 +358,7 @@ class CpuIntegrator final : public Integrator {
   /// free space left out. A free-space step so touches no memory; the fusion takes
   /// min(candidate, +tau) where a bit is set, as if each visit had proposed +tau.
   struct SectorVisitor {
+    static constexpr bool kTakesFreeWords = true;  // free_word, below
     CpuIntegrator& self;
     size_t p;
     size_t word = std::numeric_limits<size_t>::max();  // the word being gathered, none yet
@@ -376,15 +377,21 @@ class CpuIntegrator final : public Integrator {
     }
 
     void flush() {
-      if (bits == 0) return;
-      const uint64_t fresh = bits & ~self.settled_[word];
+      free_word(word, bits);
       bits = 0;
+    }
+
+    /// Free space passed in the voxels of `passed_word` that `passed` names (where the walk's
+    /// free-space loop hands it over a word at a time, free_space_walk.hpp).
+    void free_word(size_t passed_word, uint64_t passed) {
+      if (passed == 0) return;
+      const uint64_t fresh = passed & ~self.settled_[passed_word];
       if (fresh == 0) return;
-      const uint8_t owner = self.brick_owner_[word / kWordsPerBrick];
+      const uint8_t owner = self.brick_owner_[passed_word / kWordsPerBrick];
       if (owner == p) {
-        self.pass_free_space(self.parts_[p], word, fresh);
+        self.pass_free_space(self.parts_[p], passed_word, fresh);
       } else {
-        self.parts_[p].free_handed_over[owner].push_back({word, fresh});
+        self.parts_[p].free_handed_over[owner].push_back({passed_word, fresh});
       }
     }
   };

@@ -15,67 +15,18 @@
 // - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
 //   settled_free_voxel), where every candidate would be passed by, is crossed in one jump
 //   (brick_exit), which computes the state that stepping through it would reach;
+// - on the CPU, for visitors that take free space as words (kTakesFreeWords), the free space
+//   at the end of the walk is walked by a loop of its own (free_space_walk.hpp);
 // - every array is indexed by constants only (one code path per stepped axis), so the
 //   traversal state stays in registers, on the GPU too (no local memory).
 
 #include <type_traits>
 
+#include "brick_exit.hpp"
+#include "free_space_walk.hpp"
 #include "ray_marcher.hpp"
 
 namespace featsense::tsdf::detail {
-
-/// Where a walk leaves the brick it is in, and the traversal state it arrives with there.
-struct BrickExit {
-  int axis;            ///< the axis whose crossing leaves the brick
-  int32_t t;           ///< the walk's t at that crossing (ticks)
-  int32_t crossed[3];  ///< face crossings per axis up to and including it
-  int32_t t_next[3];   ///< the next crossing per axis after them
-};
-
-/// The exit of the walk from its current brick (`local`: its place in the brick), computed
-/// without stepping through the voxels: crossings of voxel faces come in the order of their
-/// t, the lower axis first on ties (the rule of the walk's step), and an axis's crossings are
-/// t_next + j * t_delta in exact integer ticks (WalkClock), so the state is exactly the one that
-/// stepping voxel by voxel reaches. A brick all of whose voxels would pass every candidate by
-/// can so be crossed in one jump. False where no axis is stepped along.
-/// Nothing depends on an earlier result but the exit itself, and no loop's length on the
-/// lane, so on the GPU a warp's jumping lanes run one short code path together.
-FEATSENSE_HD_INLINE bool brick_exit(const int32_t step[3], const int32_t local[3],
-                                    const int32_t t_next[3], const int32_t t_delta[3],
-                                    BrickExit& exit) {
-  // Arrays are indexed only by the unrolled loops' constants, so that they live in registers.
-  // Ticks stay below 2^31: t_next <= 2 kBeyondWalk and t_delta <= kBeyondWalk = 2^27 + 1.
-  static_assert(int64_t{2 + kBrickSize} * kBeyondWalk < int64_t{1} << 31, "ticks overflow");
-  int32_t to_leave[3] = {0, 0, 0};  // crossings along the axis up to the one out of the brick
-  exit.axis = -1;
-  exit.t = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (step[axis] == 0) continue;
-    to_leave[axis] = step[axis] > 0 ? kBrickSize - local[axis] : local[axis] + 1;
-    const int32_t t_out = t_next[axis] + (to_leave[axis] - 1) * t_delta[axis];
-    if (exit.axis < 0 || t_out < exit.t) {
-      exit.axis = axis;
-      exit.t = t_out;
-    }
-  }
-  if (exit.axis < 0) return false;
-  for (int axis = 0; axis < 3; ++axis) {
-    int32_t crossed = 0;
-    if (axis == exit.axis) {
-      crossed = to_leave[axis];
-    } else if (step[axis] != 0) {
-      // The crossings before the exit (at a tie, those of a lower axis): fewer than
-      // to_leave[axis], else this axis would leave first, so fewer than kBrickSize.
-      const int32_t before = exit.t + (axis < exit.axis ? 1 : 0);
-      for (int32_t j = 0; j < kBrickSize - 1; ++j) {
-        crossed += t_next[axis] + j * t_delta[axis] < before ? 1 : 0;
-      }
-    }
-    exit.crossed[axis] = crossed;
-    exit.t_next[axis] = t_next[axis] + crossed * t_delta[axis];
-  }
-  return true;
-}
 
 /// The walk's t from which every voxel it enters is free space: a voxel's centre lies within
 /// 0.87 voxels of the ray where the ray crosses it, so from here on its distance to the end
@@ -262,11 +213,19 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   const auto settled_flag = [&] {
     return settled_bricks != nullptr && inside ? settled_bricks[brick] : uint8_t{0};
   };
-  bool new_brick = settled_bricks != nullptr;  // the walk's first brick and each one it enters
+#ifdef __CUDA_ARCH__
+  constexpr bool kFreeWords = false;
+#else
+  // The CPU walks the free space at the end of a walk in a loop of its own, where the visitor
+  // takes free space as words (free_space_walk.hpp).
+  constexpr bool kFreeWords = TakesFreeWords<std::remove_reference_t<Visit> >::value;
+#endif
+  // The walk's first brick and each one it enters, where it may jump or take the free space.
+  bool new_brick = settled_bricks != nullptr || kFreeWords;
   uint8_t brick_settled = settled_flag();
   const auto enter_brick = [&] {
     brick = index / kBrickVoxels;
-    new_brick = settled_bricks != nullptr;
+    new_brick = settled_bricks != nullptr || kFreeWords;
     brick_settled = settled_flag();
   };
   // The GPU computes the storage index from the offset after every step: a dozen instructions
@@ -303,6 +262,15 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       new_brick = false;
       // A brick inside the map lies wholly inside it (the map is whole bricks).
       jump = inside && in_free_space && brick_settled != 0;
+#ifndef __CUDA_ARCH__
+      if constexpr (kFreeWords) {
+        if (inside && in_free_space) {
+          walk_free_space_words(offset, t_next, t_delta, step, i, end_turn, settled_bricks,
+                                storage_index, contains, visit);
+          return;
+        }
+      }
+#endif
     }
     // One if-else per turn, no early turn back to the loop's head: on the GPU, the lanes of a
     // warp then meet again at the end of every turn.
