@@ -236,9 +236,11 @@ TEST_F(CliMap, SigintWritesTheMapOfWhatWasRead) {
   EXPECT_EQ(WEXITSTATUS(status), 130);
   const nlohmann::json report = read_json(out / "report.json");
   EXPECT_TRUE(report["interrupted"].get<bool>());
+  // Frames mapped before the signal: on a loaded machine the first flush (which the signal
+  // waits for) may come only once all 24 are mapped, while the meshing still runs.
   const size_t frames = report["frames"].get<size_t>();
   EXPECT_GT(frames, 0u);
-  EXPECT_LT(frames, 24u);
+  EXPECT_LE(frames, 24u);
   storage::Hdf5ChunkStore store(out / "map.h5");
   EXPECT_EQ(store.read_trajectory().size(), frames);
   EXPECT_EQ(store.keys().size(), report["map"]["chunks"].get<size_t>());

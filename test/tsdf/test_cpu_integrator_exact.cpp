@@ -210,13 +210,14 @@ TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
 
 TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
   // The CPU integrator shares the map out among sectors by its thread count: one thread
-  // (four sectors) and seven (28 sectors, more candidates handed between them) must give the
-  // same map as the brute-force integrator.
+  // (eight sectors), seven (56 sectors, more candidates handed between them) and forty (as many
+  // sectors as a brick's owner byte allows, 255) must give the same map as the brute-force
+  // integrator.
   TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {16.0f, 16.0f, 6.0f};
   s.interpolation_slope = os1_interpolation_slope();
   const std::vector<RayBatch> scans = test::box_room_rays(2, false);
-  for (const int threads : {1, 7}) {
+  for (const int threads : {1, 7, 40}) {
     tbb::task_arena arena(threads);
     arena.execute([&] {
       EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans),
