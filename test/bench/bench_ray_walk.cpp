@@ -11,10 +11,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "featsense/tsdf/tsdf_settings.hpp"
+#include "free_space_lanes.hpp"
 #include "ray_walk.hpp"
 
 namespace featsense::tsdf {
@@ -70,6 +72,13 @@ struct VoxelSink {
   }
 };
 
+/// The same, the free space of the walks set aside and walked eight at a time.
+struct LaneSink : WordSink {
+  static constexpr bool kTakesFreeWalks = true;
+  std::vector<detail::FreeWalk> walks;
+  void free_walk(const detail::FreeWalk& walk) { walks.push_back(walk); }
+};
+
 template <typename Sink>
 void walk_scan(benchmark::State& state) {
   const TsdfSettings settings;
@@ -81,7 +90,25 @@ void walk_scan(benchmark::State& state) {
     Sink sink;
     for (const auto& [origin, endpoint] : rays)
       detail::walk_ray(origin, endpoint, map, params, sink);
+    if constexpr (std::is_same_v<Sink, LaneSink>) {
+      detail::FreeSpaceLanes lanes;
+      lanes.start(sink.walks.data(), sink.walks.size(), detail::FreeSpaceMap::of(map));
+      bool more = true;
+      while (more) {
+        more = lanes.walk();
+        for (size_t k = 0; k < lanes.words(); ++k) sink.free_word(lanes.word(k), lanes.bits(k));
+      }
+    }
     benchmark::DoNotOptimize(sink.folded);
+  }
+  if constexpr (std::is_same_v<Sink, LaneSink>) {
+    Sink sink;
+    for (const auto& [origin, endpoint] : rays)
+      detail::walk_ray(origin, endpoint, map, params, sink);
+    double turns = 0;
+    for (const detail::FreeWalk& walk : sink.walks) turns += walk.turns;
+    state.counters["free_walks"] = static_cast<double>(sink.walks.size());
+    state.counters["free_voxels"] = turns;
   }
   state.counters["rays/s"] = benchmark::Counter(static_cast<double>(rays.size()),
                                                 benchmark::Counter::kIsIterationInvariantRate);
@@ -89,8 +116,10 @@ void walk_scan(benchmark::State& state) {
 
 void Words(benchmark::State& state) { walk_scan<WordSink>(state); }
 void Voxels(benchmark::State& state) { walk_scan<VoxelSink>(state); }
+void Lanes(benchmark::State& state) { walk_scan<LaneSink>(state); }
 BENCHMARK(Words)->Unit(benchmark::kMillisecond);
 BENCHMARK(Voxels)->Unit(benchmark::kMillisecond);
+BENCHMARK(Lanes)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace featsense::tsdf

@@ -17,6 +17,7 @@
 #include "brick_checks.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "free_space_fusion.hpp"
+#include "free_space_lanes.hpp"
 #include "huge_page_allocator.hpp"
 #include "ray_walk.hpp"
 
@@ -111,6 +112,7 @@ class CpuIntegrator final : public Integrator {
     // locked instruction (a compare-exchange per voxel cost more than the rest of the visit).
     const Vec3 centre = rays.origin(kept.front());
     assign_brick_owners(centre);
+    free_map_ = detail::FreeSpaceMap::of(geometry_);
     const std::vector<std::vector<uint32_t>> rays_of = rays_by_sector(rays, kept, centre);
     for (Part& part : parts_) {
       part.touched.clear();
@@ -163,6 +165,8 @@ class CpuIntegrator final : public Integrator {
     std::vector<uint32_t> touched;                        ///< bricks listed for the fusion
     std::vector<std::vector<HandedOver>> handed_over;     ///< by owning sector
     std::vector<std::vector<FreeBits>> free_handed_over;  ///< by owning sector
+    std::vector<detail::FreeWalk> free_walks;             ///< set aside for the lanes
+    detail::FreeSpaceLanes lanes;                         ///< which walk them
   };
 
   /// Indices of the rays to march: all, or the first end point of each voxel of the local
@@ -362,6 +366,7 @@ class CpuIntegrator final : public Integrator {
   /// min(candidate, +tau) where a bit is set, as if each visit had proposed +tau.
   struct SectorVisitor {
     static constexpr bool kTakesFreeWords = true;  // free_word, below
+    static constexpr bool kTakesFreeWalks = true;  // free_walk, below
     CpuIntegrator& self;
     size_t p;
     size_t word = std::numeric_limits<size_t>::max();  // the word being gathered, none yet
@@ -382,6 +387,43 @@ class CpuIntegrator final : public Integrator {
     void flush() {
       free_word(word, bits);
       bits = 0;
+    }
+
+    /// The free space at the end of a walk: set aside for the lanes (free_space_lanes.hpp),
+    /// which walk the sector's walks eight at a time when it is done with its rays, or where
+    /// the processor can't run them, walked here and now.
+    void free_walk(const detail::FreeWalk& walk) {
+      if (self.lanes_supported_) {
+        self.parts_[p].free_walks.push_back(walk);
+      } else {
+        detail::walk_free_space_job(walk, self.free_map_, self.settled_bricks_.data(), *this);
+      }
+    }
+
+    static constexpr size_t kWordsAhead = 16;
+
+    /// Walks the walks set aside, and hands what was gathered over.
+    void finish() {
+      flush();
+      Part& part = self.parts_[p];
+      if (part.free_walks.empty()) return;
+      part.lanes.start(part.free_walks.data(), part.free_walks.size(), self.free_map_);
+      bool more = true;
+      while (more) {
+        more = part.lanes.walk();
+        // The words lie all over the map: their bit words are asked for ahead, so that the
+        // loads of many words overlap (waiting for each in turn was a third of the time here).
+        const size_t count = part.lanes.words();
+        for (size_t k = 0; k < count; ++k) {
+          if (k + kWordsAhead < count) {
+            const auto ahead = static_cast<size_t>(part.lanes.word(k + kWordsAhead));
+            __builtin_prefetch(&self.settled_[ahead]);
+            __builtin_prefetch(&self.free_space_[ahead], 1);
+          }
+          free_word(static_cast<size_t>(part.lanes.word(k)), part.lanes.bits(k));
+        }
+      }
+      part.free_walks.clear();
     }
 
     /// Free space passed in the voxels of `passed_word` that `passed` names (where the walk's
@@ -431,7 +473,7 @@ class CpuIntegrator final : public Integrator {
       detail::walk_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray, visit,
                        settled_bricks_.data());
     }
-    visit.flush();
+    visit.finish();
   }
 
   /// Sector p applies what the other sectors handed over to it.
@@ -487,6 +529,8 @@ class CpuIntegrator final : public Integrator {
   std::vector<uint8_t> settled_bricks_;  ///< 1 per brick of settled free space only
   uint32_t settled_voxel_;               ///< what such a voxel holds
   std::vector<Part> parts_;              ///< one per sector
+  detail::FreeSpaceMap free_map_{};      ///< the map as free-space walks see it, this scan
+  const bool lanes_supported_ = detail::FreeSpaceLanes::supported();
 };
 
 }  // namespace

@@ -28,6 +28,27 @@ template <typename Visit>
 struct TakesFreeWords<Visit, std::void_t<decltype(Visit::kTakesFreeWords)>>
     : std::bool_constant<Visit::kTakesFreeWords> {};
 
+/// A walk's free space set aside, to be walked later with others (free_space_lanes.hpp): the
+/// walk's state at its current voxel (inside the map, not yet visited), from which every voxel
+/// up to the walk's end is free space.
+struct FreeWalk {
+  int32_t offset[3];   ///< the voxel: global index less the map's lowest corner
+  int32_t t_next[3];   ///< the next crossing per axis (ticks; INT32_MAX where never stepped)
+  int32_t t_delta[3];  ///< ticks between crossings per axis
+  int32_t step[3];     ///< -1, 0 or 1 per axis
+  int32_t turns;       ///< voxels left to visit, the current one included (>= 1)
+};
+
+/// Whether a walk's visitor takes the free space at the end of a walk as a whole:
+/// `free_walk(const FreeWalk&)` instead of free_word calls (which it must then make itself,
+/// for exactly the voxels walk_free_space_words would hand over, settled bricks aside). A
+/// visitor says so with `static constexpr bool kTakesFreeWalks = true;`.
+template <typename Visit, typename = void>
+struct TakesFreeWalks : std::false_type {};
+template <typename Visit>
+struct TakesFreeWalks<Visit, std::void_t<decltype(Visit::kTakesFreeWalks)>>
+    : std::bool_constant<Visit::kTakesFreeWalks> {};
+
 /// Walks from the current voxel (turn `turn`, inside the map, at the first voxel of a brick the
 /// walk enters, not yet visited) to the walk's end, where every voxel is free space. `offset`
 /// is the walk's: storage_index() and contains() read it (the general walk's functions).

@@ -16,7 +16,8 @@
 //   settled_free_voxel), where every candidate would be passed by, is crossed in one jump
 //   (brick_exit), which computes the state that stepping through it would reach;
 // - on the CPU, for visitors that take free space as words (kTakesFreeWords), the free space
-//   at the end of the walk is walked by a loop of its own (free_space_walk.hpp);
+//   at the end of the walk is walked by a loop of its own (free_space_walk.hpp), or handed
+//   to the visitor whole, to be walked together with other walks (free_space_lanes.hpp);
 // - every array is indexed by constants only (one code path per stepped axis), so the
 //   traversal state stays in registers, on the GPU too (no local memory).
 
@@ -265,8 +266,16 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
 #ifndef __CUDA_ARCH__
       if constexpr (kFreeWords) {
         if (inside && in_free_space) {
-          walk_free_space_words(offset, t_next, t_delta, step, i, end_turn, settled_bricks,
-                                storage_index, contains, visit);
+          if constexpr (TakesFreeWalks<std::remove_reference_t<Visit> >::value) {
+            visit.free_walk(FreeWalk{{offset[0], offset[1], offset[2]},
+                                     {t_next[0], t_next[1], t_next[2]},
+                                     {t_delta[0], t_delta[1], t_delta[2]},
+                                     {step[0], step[1], step[2]},
+                                     end_turn - i});
+          } else {
+            walk_free_space_words(offset, t_next, t_delta, step, i, end_turn, settled_bricks,
+                                  storage_index, contains, visit);
+          }
           return;
         }
       }
