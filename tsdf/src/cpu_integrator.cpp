@@ -18,6 +18,7 @@
 #include "featsense/tsdf/integrator.hpp"
 #include "free_space_fusion.hpp"
 #include "free_space_lanes.hpp"
+#include "free_word_cache.hpp"
 #include "huge_page_allocator.hpp"
 #include "ray_walk.hpp"
 
@@ -167,6 +168,7 @@ class CpuIntegrator final : public Integrator {
     std::vector<std::vector<FreeBits>> free_handed_over;  ///< by owning sector
     std::vector<detail::FreeWalk> free_walks;             ///< set aside for the lanes
     detail::FreeSpaceLanes lanes;                         ///< which walk them
+    detail::FreeWordCache word_cache;                     ///< what they pass, merged
   };
 
   /// Indices of the rays to march: all, or the first end point of each voxel of the local
@@ -400,29 +402,29 @@ class CpuIntegrator final : public Integrator {
       }
     }
 
-    static constexpr size_t kWordsAhead = 16;
-
     /// Walks the walks set aside, and hands what was gathered over.
     void finish() {
       flush();
       Part& part = self.parts_[p];
       if (part.free_walks.empty()) return;
       part.lanes.start(part.free_walks.data(), part.free_walks.size(), self.free_map_);
+      const auto hand_on = [this](size_t passed_word, uint64_t passed) {
+        free_word(passed_word, passed);
+      };
       bool more = true;
       while (more) {
         more = part.lanes.walk();
-        // The words lie all over the map: their bit words are asked for ahead, so that the
-        // loads of many words overlap (waiting for each in turn was a third of the time here).
-        const size_t count = part.lanes.words();
-        for (size_t k = 0; k < count; ++k) {
-          if (k + kWordsAhead < count) {
-            const auto ahead = static_cast<size_t>(part.lanes.word(k + kWordsAhead));
-            __builtin_prefetch(&self.settled_[ahead]);
-            __builtin_prefetch(&self.free_space_[ahead], 1);
+        for (size_t k = 0; k < part.lanes.words(); ++k) {
+          const auto passed_word = static_cast<size_t>(part.lanes.word(k));
+          if (part.word_cache.add(passed_word, part.lanes.bits(k), hand_on)) {
+            // Its bit words are seldom cached: asked for now, they are there when it is
+            // handed on.
+            __builtin_prefetch(&self.settled_[passed_word]);
+            __builtin_prefetch(&self.free_space_[passed_word], 1);
           }
-          free_word(static_cast<size_t>(part.lanes.word(k)), part.lanes.bits(k));
         }
       }
+      part.word_cache.flush(hand_on);
       part.free_walks.clear();
     }
 
