@@ -18,66 +18,137 @@ namespace {
 constexpr int kLanes = 8;
 /// Words written out per walk() call at most (a step writes up to kLanes).
 constexpr size_t kWordCapacity = 4096;
-/// A count of bricks no walk inside the map reaches (axes never stepped along).
-constexpr int32_t kNever = 1 << 30;
+
+/// The place of a voxel in its brick as the lanes keep it: x + 8, y + 8 and z + 8 in fields of
+/// five bits. A step adds or subtracts one in a field; the field then lies in [7, 16], and the
+/// step left the brick where it is 7 or 16, the only values whose bits 3 and 4 are not 0b01.
+/// `field & 7 | 8` then wraps it into the next brick (16 -> 8, 7 -> 15). The walk's place so
+/// needs no test of the axis it stepped along.
+constexpr int32_t kFieldBits = 5;
+constexpr int32_t kPlaceBias = 8 | 8 << kFieldBits | 8 << 2 * kFieldBits;
+constexpr int32_t kPlaceLow = 7 | 7 << kFieldBits | 7 << 2 * kFieldBits;
+constexpr int32_t kPlaceGuard = 24 | 24 << kFieldBits | 24 << 2 * kFieldBits;
+
+/// Crossings of `axis` before tick `tick` (those with t < tick).
+int64_t crossings_before(const FreeWalk& w, int axis, int64_t tick) {
+  if (w.step[axis] == 0 || tick <= w.t_next[axis]) return 0;
+  return (tick - 1 - w.t_next[axis]) / w.t_delta[axis] + 1;
+}
+
+/// Cuts `walk` where it leaves the map or crosses the ring buffer's seam (where a brick's
+/// slot jumps from the last to the first), so that inside a part the storage brick moves by
+/// one stride a brick: `walk` keeps the voxels before that crossing; the rest, after it, goes to
+/// `rest` (true), or nowhere where the walk leaves the map or ends first (false). The crossing
+/// is the first of the crossings per axis that would take the walk there, in the walk's order
+/// (t, the lower axis first on ties); the voxels before it are the crossings before it plus one.
+bool cut_at_seam(FreeWalk& walk, FreeWalk& rest, const FreeSpaceMap& map) {
+  constexpr int64_t kNone = INT64_MAX;
+  int64_t event_tick = kNone;
+  int event_axis = -1;
+  int64_t event_crossings = 0;  // along event_axis, itself included
+  bool leaves = false;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int32_t s = walk.step[axis];
+    if (s == 0) continue;
+    const int32_t o = walk.offset[axis];
+    const int32_t dim = map.bricks[axis] * kBrickSize;
+    // The first voxel of slot 0, where the ring buffer's seam lies inside the map.
+    const int32_t seam = (map.bricks[axis] - map.lowest_slot[axis]) * kBrickSize;
+    const bool has_seam = map.lowest_slot[axis] != 0;
+    int64_t n = s > 0 ? dim - o : o + 1;  // crossings to leave the map
+    bool leaving = true;
+    if (has_seam && (s > 0 ? o < seam : o >= seam)) {
+      const int64_t to_seam = s > 0 ? seam - o : o - seam + 1;
+      if (to_seam < n) {
+        n = to_seam;
+        leaving = false;
+      }
+    }
+    if (n >= walk.turns) continue;  // more crossings than the walk has voxels
+    const int64_t tick = walk.t_next[axis] + (n - 1) * int64_t{walk.t_delta[axis]};
+    if (tick < event_tick) {  // axes in increasing order: a tie keeps the lower one
+      event_tick = tick;
+      event_axis = axis;
+      event_crossings = n;
+      leaves = leaving;
+    }
+  }
+  if (event_axis < 0) return false;
+  int64_t crossed[3];
+  int64_t before = 0;  // crossings before the event's
+  for (int axis = 0; axis < 3; ++axis) {
+    crossed[axis] = axis == event_axis
+                        ? event_crossings - 1
+                        : crossings_before(walk, axis, event_tick + (axis < event_axis ? 1 : 0));
+    before += crossed[axis];
+  }
+  if (before + 1 >= walk.turns) return false;  // the walk ends first
+  const int32_t total = walk.turns;
+  walk.turns = static_cast<int32_t>(before + 1);
+  if (leaves) return false;
+  rest = walk;
+  crossed[event_axis] += 1;  // the crossing of the seam itself
+  for (int axis = 0; axis < 3; ++axis) {
+    if (walk.step[axis] == 0) continue;
+    rest.offset[axis] += walk.step[axis] * static_cast<int32_t>(crossed[axis]);
+    rest.t_next[axis] += static_cast<int32_t>(crossed[axis]) * walk.t_delta[axis];
+  }
+  rest.turns = total - walk.turns;
+  return true;
+}
 }  // namespace
 
 /// The lanes' state, a row of kLanes per quantity (loaded as vectors), and the output.
 struct FreeSpaceLanes::State {
-  alignas(32) int32_t next[3][kLanes];   ///< the next crossing per axis (ticks)
-  alignas(32) int32_t delta[3][kLanes];  ///< ticks between crossings
-  alignas(32) int32_t place[kLanes];     ///< the voxel in its brick: (z * 8 + y) * 8 + x
-  alignas(32) int32_t left[kLanes];      ///< voxels left to visit; <= 0: no walk
-  alignas(32) int32_t low[kLanes];       ///< the word's bits 0-31 gathered so far
-  alignas(32) int32_t high[kLanes];      ///< bits 32-63
-  alignas(32) int32_t brick[kLanes];     ///< storage brick
-  alignas(32) int32_t edge[3][kLanes];   ///< the place along the axis a step leaves the brick from
-  alignas(32) int32_t move[3][kLanes];   ///< what a step inside the brick adds to the place
-  alignas(32) int32_t cross[3][kLanes];  ///< what a step out of the brick adds to the place
-  alignas(32) int32_t forward[3][kLanes];   ///< what a step out of the brick adds to brick
-  alignas(32) int32_t wrap_fix[3][kLanes];  ///< added too where the ring buffer wraps
-  alignas(32) int32_t to_wrap[3][kLanes];   ///< bricks left along the axis until the wrap
-  alignas(32) int32_t to_leave[3][kLanes];  ///< bricks left along the axis inside the map
+  alignas(32) int32_t next[3][kLanes];     ///< the next crossing per axis (ticks)
+  alignas(32) int32_t delta[3][kLanes];    ///< ticks between crossings
+  alignas(32) int32_t place[kLanes];       ///< the voxel in its brick (kPlaceBias)
+  alignas(32) int32_t left[kLanes];        ///< voxels left to visit; <= 0: no walk
+  alignas(32) int32_t low[kLanes];         ///< the word's bits 0-31 gathered so far
+  alignas(32) int32_t high[kLanes];        ///< bits 32-63
+  alignas(32) int32_t brick[kLanes];       ///< storage brick
+  alignas(32) int32_t move[3][kLanes];     ///< what a step along the axis adds to the place
+  alignas(32) int32_t forward[3][kLanes];  ///< what a step out of the brick adds to brick
+
+  FreeWalk rest[kLanes];  ///< what a lane walks after its part, beyond the ring's seam
+  bool has_rest[kLanes] = {};
 
   const FreeWalk* walks = nullptr;
   size_t walk_count = 0;
   size_t next_walk = 0;
   FreeSpaceMap map{};
 
-  /// Puts a walk into lane l.
-  void load(int l, const FreeWalk& w) {
-    constexpr int32_t kStride[3] = {1, kBrickSize, kBrickSize * kBrickSize};  // in the brick
+  /// Puts a walk into lane l, up to the ring buffer's seam or the map's edge.
+  void load(int l, FreeWalk w) {
+    has_rest[l] = cut_at_seam(w, rest[l], map);
     const int32_t brick_stride[3] = {1, map.bricks[0], map.bricks[0] * map.bricks[1]};
+    int32_t in_brick = 0;
     for (int axis = 0; axis < 3; ++axis) {
       const int32_t s = w.step[axis];
-      const int32_t nb = map.bricks[axis];
-      const int32_t b = w.offset[axis] >> kBrickShift;
-      const int32_t raw_slot = map.lowest_slot[axis] + b;
-      const int32_t slot = raw_slot >= nb ? raw_slot - nb : raw_slot;
       next[axis][l] = w.t_next[axis];
       delta[axis][l] = w.t_delta[axis];
-      edge[axis][l] = s < 0 ? 0 : kBrickSize - 1;
-      move[axis][l] = s * kStride[axis];
-      cross[axis][l] = s * (kStride[axis] - kBrickSize * kStride[axis]);
+      move[axis][l] = s * (1 << axis * kFieldBits);
       forward[axis][l] = s * brick_stride[axis];
-      wrap_fix[axis][l] = -s * nb * brick_stride[axis];
-      to_wrap[axis][l] = s > 0 ? nb - 1 - slot : s < 0 ? slot : kNever;
-      to_leave[axis][l] = s > 0 ? nb - 1 - b : s < 0 ? b : kNever;
+      in_brick |= (w.offset[axis] & (kBrickSize - 1)) << axis * kFieldBits;
     }
-    place[l] = ((w.offset[2] & (kBrickSize - 1)) * kBrickSize + (w.offset[1] & (kBrickSize - 1))) *
-                   kBrickSize +
-               (w.offset[0] & (kBrickSize - 1));
+    place[l] = in_brick | kPlaceBias;
     left[l] = w.turns;
     low[l] = 0;
     high[l] = 0;
     brick[l] = map.brick_of(w.offset);
   }
 
-  /// Gives every idle lane the next walk; false where no lane has one.
+  /// Gives every idle lane the rest of its walk or the next walk; false where no lane has one.
   bool refill() {
     bool any = false;
     for (int l = 0; l < kLanes; ++l) {
-      if (left[l] <= 0 && next_walk < walk_count) load(l, walks[next_walk++]);
+      if (left[l] <= 0) {
+        if (has_rest[l]) {
+          load(l, rest[l]);
+        } else if (next_walk < walk_count) {
+          load(l, walks[next_walk++]);
+        }
+      }
       any = any || left[l] > 0;
     }
     return any;
@@ -123,26 +194,25 @@ __attribute__((target("avx2,popcnt"))) bool FreeSpaceLanes::State::walk_avx2(
   const __m256i zero = _mm256_setzero_si256();
   const __m256i one = _mm256_set1_epi32(1);
   const __m256i seven = _mm256_set1_epi32(kBrickSize - 1);
-  const __m256i low_six = _mm256_set1_epi32(63);
   const __m256i thirty_two = _mm256_set1_epi32(32);
+  const __m256i place_low = _mm256_set1_epi32(kPlaceLow);
+  const __m256i place_bias = _mm256_set1_epi32(kPlaceBias);
+  const __m256i place_guard = _mm256_set1_epi32(kPlaceGuard);
+  const __m256i y_bits = _mm256_set1_epi32(7 << 3);
   for (;;) {
     out.count = out_count;
     if (!refill()) return false;
     __m256i nx = row(next[0]), ny = row(next[1]), nz = row(next[2]);
     const __m256i dx = row(delta[0]), dy = row(delta[1]), dz = row(delta[2]);
     __m256i pl = row(place), lf = row(left), lo = row(low), hi = row(high), br = row(brick);
-    const __m256i ex = row(edge[0]), ey = row(edge[1]), ez = row(edge[2]);
     const __m256i mvx = row(move[0]), mvy = row(move[1]), mvz = row(move[2]);
-    const __m256i crx = row(cross[0]), cry = row(cross[1]), crz = row(cross[2]);
     const __m256i fwx = row(forward[0]), fwy = row(forward[1]), fwz = row(forward[2]);
-    const __m256i wfx = row(wrap_fix[0]), wfy = row(wrap_fix[1]), wfz = row(wrap_fix[2]);
-    __m256i twx = row(to_wrap[0]), twy = row(to_wrap[1]), twz = row(to_wrap[2]);
-    __m256i tlx = row(to_leave[0]), tly = row(to_leave[1]), tlz = row(to_leave[2]);
     bool full = false;
     for (;;) {
       const __m256i active = _mm256_cmpgt_epi32(lf, zero);
-      // The current voxel's bit (a shift by 32 or more gives 0: the other half's).
-      const __m256i bit = _mm256_and_si256(pl, low_six);
+      // The current voxel's bit, x + 8 y (a shift by 32 or more gives 0: the other half's).
+      const __m256i bit = _mm256_or_si256(_mm256_and_si256(pl, seven),
+                                          _mm256_and_si256(_mm256_srli_epi32(pl, 2), y_bits));
       lo = _mm256_or_si256(lo, _mm256_sllv_epi32(one, bit));
       hi = _mm256_or_si256(hi, _mm256_sllv_epi32(one, _mm256_sub_epi32(bit, thirty_two)));
       const __m256i ended = _mm256_cmpeq_epi32(lf, one);
@@ -155,17 +225,15 @@ __attribute__((target("avx2,popcnt"))) bool FreeSpaceLanes::State::walk_avx2(
       nx = _mm256_add_epi32(nx, _mm256_and_si256(dx, along_x));
       ny = _mm256_add_epi32(ny, _mm256_and_si256(dy, along_y));
       nz = _mm256_add_epi32(nz, _mm256_and_si256(dz, along_z));
-      // Whether the step leaves the brick.
-      const __m256i pz = _mm256_srli_epi32(pl, 6);
-      const __m256i out_x =
-          _mm256_and_si256(along_x, _mm256_cmpeq_epi32(_mm256_and_si256(pl, seven), ex));
-      const __m256i out_y = _mm256_and_si256(
-          along_y, _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_srli_epi32(pl, 3), seven), ey));
-      const __m256i out_z = _mm256_and_si256(along_z, _mm256_cmpeq_epi32(pz, ez));
+      // The step, and whether it left the brick.
+      const __m256i moved = _mm256_add_epi32(
+          pl, _mm256_blendv_epi8(_mm256_blendv_epi8(mvx, mvy, along_y), mvz, along_z));
+      const __m256i inside = _mm256_cmpeq_epi32(_mm256_and_si256(moved, place_guard), place_bias);
       // A word is done where the walk ends, steps along z or leaves the brick.
-      const __m256i done_word = _mm256_and_si256(
-          active, _mm256_or_si256(_mm256_or_si256(ended, along_z), _mm256_or_si256(out_x, out_y)));
-      const __m256i word = _mm256_add_epi32(_mm256_slli_epi32(br, 3), pz);
+      const __m256i done_word =
+          _mm256_andnot_si256(_mm256_andnot_si256(_mm256_or_si256(ended, along_z), inside), active);
+      const __m256i z = _mm256_and_si256(_mm256_srli_epi32(pl, 2 * kFieldBits), seven);
+      const __m256i word = _mm256_add_epi32(_mm256_slli_epi32(br, 3), z);
       const int mask = _mm256_movemask_ps(_mm256_castsi256_ps(done_word));
       const __m256i pick = row(kCompress.lanes[mask]);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out_word[out_count]),
@@ -177,44 +245,16 @@ __attribute__((target("avx2,popcnt"))) bool FreeSpaceLanes::State::walk_avx2(
       out_count += static_cast<size_t>(__builtin_popcount(static_cast<unsigned>(mask)));
       lo = _mm256_andnot_si256(done_word, lo);
       hi = _mm256_andnot_si256(done_word, hi);
-      // The place in the brick, in this brick or the next.
-      const __m256i moved = _mm256_or_si256(
-          _mm256_or_si256(_mm256_and_si256(along_x, _mm256_blendv_epi8(mvx, crx, out_x)),
-                          _mm256_and_si256(along_y, _mm256_blendv_epi8(mvy, cry, out_y))),
-          _mm256_and_si256(along_z, _mm256_blendv_epi8(mvz, crz, out_z)));
-      pl = _mm256_add_epi32(pl, moved);
-      // The next brick: one stride on, less the ring buffer's length where it wraps.
-      const __m256i wraps_x = _mm256_and_si256(out_x, _mm256_cmpeq_epi32(twx, zero));
-      const __m256i wraps_y = _mm256_and_si256(out_y, _mm256_cmpeq_epi32(twy, zero));
-      const __m256i wraps_z = _mm256_and_si256(out_z, _mm256_cmpeq_epi32(twz, zero));
-      const __m256i brick_step = _mm256_or_si256(
-          _mm256_or_si256(_mm256_and_si256(out_x, fwx), _mm256_and_si256(out_y, fwy)),
-          _mm256_and_si256(out_z, fwz));
-      const __m256i brick_wrap = _mm256_or_si256(
-          _mm256_or_si256(_mm256_and_si256(wraps_x, wfx), _mm256_and_si256(wraps_y, wfy)),
-          _mm256_and_si256(wraps_z, wfz));
-      br = _mm256_add_epi32(br, _mm256_add_epi32(brick_step, brick_wrap));
-      // Masks are -1: adding one counts a brick down.
-      twx = _mm256_add_epi32(twx, out_x);
-      twy = _mm256_add_epi32(twy, out_y);
-      twz = _mm256_add_epi32(twz, out_z);
-      tlx = _mm256_add_epi32(tlx, out_x);
-      tly = _mm256_add_epi32(tly, out_y);
-      tlz = _mm256_add_epi32(tlz, out_z);
-      // A walk leaves the map once, for good (its axes are monotonic).
-      const __m256i left_map = _mm256_and_si256(
-          active, _mm256_cmpgt_epi32(zero, _mm256_or_si256(_mm256_or_si256(tlx, tly), tlz)));
-      const __m256i finished = _mm256_or_si256(ended, left_map);
+      pl = _mm256_or_si256(_mm256_and_si256(moved, place_low), place_bias);
+      // Out of the brick: one stride on (a part never crosses the ring's seam).
+      br = _mm256_add_epi32(
+          br, _mm256_andnot_si256(
+                  inside, _mm256_blendv_epi8(_mm256_blendv_epi8(fwx, fwy, along_y), fwz, along_z)));
       full = out_count + kLanes > kWordCapacity;
-      if ((_mm256_movemask_ps(_mm256_castsi256_ps(finished)) != 0) | full) {
-        lf = _mm256_andnot_si256(left_map, lf);  // a lane that left the map has no walk
-        break;
-      }
+      if ((_mm256_movemask_ps(_mm256_castsi256_ps(ended)) != 0) | full) break;
     }
     put(next[0], nx), put(next[1], ny), put(next[2], nz);
     put(place, pl), put(left, lf), put(low, lo), put(high, hi), put(brick, br);
-    put(to_wrap[0], twx), put(to_wrap[1], twy), put(to_wrap[2], twz);
-    put(to_leave[0], tlx), put(to_leave[1], tly), put(to_leave[2], tlz);
     if (full) {
       out.count = out_count;
       return true;
