@@ -26,6 +26,7 @@
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
 #include "tsdf_test_support.hpp"
+#include "varied_rays.hpp"
 
 namespace featsense::tsdf {
 namespace {
@@ -503,26 +504,8 @@ TEST(CpuIntegratorExact, FreeSpaceWalkedAsWordsIsTheWalksFreeSpace) {
   std::mt19937 random(13);
   for (uint8_t& brick : settled) brick = random() % 3 == 0 ? 1 : 0;
 
-  std::vector<std::pair<Vec3, Vec3>> rays;  // origin, end point
-  const float corner = 8 * s.voxel_size_m;
-  for (const Vec3 origin : {test::make_vec(0, 0, 0), test::make_vec(corner, corner, corner),
-                            test::make_vec(0.01, -0.02, 1.5)}) {
-    for (const Vec3 d :
-         {test::make_vec(1, 1, 0), test::make_vec(-1, 1, 0), test::make_vec(1, 1, 1),
-          test::make_vec(-1, -1, -1), test::make_vec(1, 0, 0), test::make_vec(0, -1, 0.5),
-          test::make_vec(0.1, 0.2, -1), test::make_vec(1, 2, 0), test::make_vec(2, -1, 2)}) {
-      rays.emplace_back(origin, origin + (5.5f / norm(d)) * d);
-    }
-  }
-  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
-  for (int k = 0; k < 600; ++k) {
-    const float reach = k % 5 == 0 ? 28.0f : 15.0f;  // the map reaches 20 m from its centre
-    const Vec3 origin = test::make_vec(reach * uniform(random), reach * uniform(random),
-                                       1.5 + 2.0f * uniform(random));
-    const float steepness = k % 4 == 0 ? 2.0f : 0.3f;
-    const Vec3 d{uniform(random), uniform(random), steepness * uniform(random)};
-    rays.emplace_back(origin, origin + (1.0f + 25.0f * std::fabs(uniform(random))) * d);
-  }
+  const std::vector<std::pair<Vec3, Vec3>> rays =
+      test::varied_rays(s.voxel_size_m, 5.5f, 600, random);
 
   size_t free_voxels = 0;
   size_t words = 0;

@@ -16,6 +16,7 @@
 #include "free_space_lanes.hpp"
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
+#include "varied_rays.hpp"
 
 namespace featsense::tsdf {
 namespace {
@@ -55,32 +56,6 @@ struct WalkVisitor {
   void free_walk(const detail::FreeWalk& walk) { walks->push_back(walk); }
 };
 
-/// Rays of every kind the walk meets (see the file's comment).
-std::vector<Ray> varied_rays(float voxel_size_m) {
-  std::vector<Ray> rays;
-  const float corner = kBrickSize * voxel_size_m;
-  for (const Vec3 origin : {test::make_vec(0, 0, 1.5), test::make_vec(corner, corner, corner),
-                            test::make_vec(0.01, -0.02, 1.5)}) {
-    for (const Vec3 d :
-         {test::make_vec(1, 1, 0), test::make_vec(-1, 1, 0), test::make_vec(1, 1, 1),
-          test::make_vec(-1, -1, -1), test::make_vec(1, 0, 0), test::make_vec(0, -1, 0.5),
-          test::make_vec(0.1, 0.2, -1), test::make_vec(1, 2, 0), test::make_vec(2, -1, 2)}) {
-      rays.emplace_back(origin, origin + (9.5f / norm(d)) * d);
-    }
-  }
-  std::mt19937 random(29);
-  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
-  for (int k = 0; k < 1500; ++k) {
-    const float reach = k % 5 == 0 ? 28.0f : 12.0f;  // the map reaches 20 m from its centre
-    const Vec3 origin = test::make_vec(reach * uniform(random), reach * uniform(random),
-                                       1.5 + 2.0f * uniform(random));
-    const float steepness = k % 4 == 0 ? 2.0f : 0.3f;
-    const Vec3 d{uniform(random), uniform(random), steepness * uniform(random)};
-    rays.emplace_back(origin, origin + (1.0f + 25.0f * std::fabs(uniform(random))) * d);
-  }
-  return rays;
-}
-
 class FreeSpaceLanesTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -101,7 +76,7 @@ TEST_F(FreeSpaceLanesTest, LanesWalkTheFreeSpaceMarchRayProposes) {
   std::mt19937 random(31);
   for (uint8_t& brick : settled) brick = random() % 3 == 0 ? 1 : 0;
 
-  const std::vector<Ray> rays = varied_rays(s.voxel_size_m);
+  const std::vector<Ray> rays = test::varied_rays(s.voxel_size_m, 9.5f, 1500, random);
   const uint8_t* const brick_sets[] = {nullptr, settled.data()};
   for (const uint8_t* bricks : brick_sets) {
     FreeSet reference{bricks, {}};

@@ -3,10 +3,13 @@
 // crossing comes next, which follows no pattern: the scalar loop (free_space_walk.hpp) branches
 // on it and mispredicts about every other voxel, which was most of its 14 cycles a voxel on the
 // real OS1-128 frames. Here each of eight AVX2 lanes walks a ray of its own and every lane takes
-// the same instructions at every step: which axis steps, whether the step leaves the brick and
-// where the brick lies in the ring buffer are masks, and a word of 64 voxels is written out
-// (compressed, the lanes that finished one only) where a lane leaves it. A lane whose walk ends
-// or leaves the map takes the next walk.
+// the same instructions at every step: which axis steps and whether the step leaves the brick
+// are masks, and a word of 64 voxels is written out (compressed: the lanes that finished one
+// only) where a lane leaves it. A lane whose walk ends takes the next walk.
+//
+// A walk is cut, before a lane takes it, where it leaves the map or crosses the ring buffer's
+// seam (computed from its crossings), so that inside a part a step out of a brick always moves
+// the storage brick by one stride: the lanes need no bounds and no wrap.
 //
 // Exact: each lane makes the scalar loop's steps in the same order (the same integer ticks,
 // the lower axis first on ties). One difference, which leaves the map the same: bricks of
@@ -74,7 +77,7 @@ void walk_free_space_job(FreeWalk walk, const FreeSpaceMap& map, const uint8_t* 
 ///   lanes.start(walks, count, map);
 ///   do { more = lanes.walk(); for k < lanes.words(): visit(lanes.word(k), lanes.bits(k)); }
 ///   while (more);
-/// Bricks per axis must be below 2^20 (nothing near: a map of 1 km at 1 cm has 12500).
+/// Word indices are 32-bit: a map of fewer than 2^37 voxels (far more than memory holds).
 class FreeSpaceLanes {
  public:
   /// Whether this processor can run it (AVX2).
