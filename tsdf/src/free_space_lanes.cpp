@@ -2,8 +2,7 @@
 
 #include "free_space_lanes.hpp"
 
-#include <array>
-#include <vector>
+#include <limits>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -42,7 +41,7 @@ int64_t crossings_before(const FreeWalk& w, int axis, int64_t tick) {
 /// is the first of the crossings per axis that would take the walk there, in the walk's order
 /// (t, the lower axis first on ties); the voxels before it are the crossings before it plus one.
 bool cut_at_seam(FreeWalk& walk, FreeWalk& rest, const FreeSpaceMap& map) {
-  constexpr int64_t kNone = INT64_MAX;
+  constexpr int64_t kNone = std::numeric_limits<int64_t>::max();
   int64_t event_tick = kNone;
   int event_axis = -1;
   int64_t event_crossings = 0;  // along event_axis, itself included
@@ -286,7 +285,10 @@ FreeSpaceLanes& FreeSpaceLanes::operator=(FreeSpaceLanes&&) noexcept = default;
 
 void FreeSpaceLanes::start(const FreeWalk* walks, size_t count, const FreeSpaceMap& map) {
   State& s = *state_;
-  for (int l = 0; l < kLanes; ++l) s.left[l] = 0;
+  for (int l = 0; l < kLanes; ++l) {
+    s.left[l] = 0;
+    s.has_rest[l] = false;
+  }
   s.walks = walks;
   s.walk_count = count;
   s.next_walk = 0;
