@@ -189,9 +189,16 @@ class CpuIntegrator final : public Integrator {
       for (size_t i = 0; i < rays.size(); ++i) kept.push_back(static_cast<uint32_t>(i));
       return kept;
     }
-    // The storage index of each end point's voxel, or none for points outside the map.
+    // The storage index of each end point's voxel, or none for points outside the map. The
+    // voxels lie all over the map: each loop asks for the one kPointsAhead points on ahead.
     constexpr size_t kOutside = std::numeric_limits<size_t>::max();
+    constexpr size_t kPointsAhead = 16;
     std::vector<size_t> end_voxel(rays.size());
+    const auto prefetch_ahead = [&](size_t i, size_t end) {
+      if (i + kPointsAhead < end && end_voxel[i + kPointsAhead] != kOutside) {
+        __builtin_prefetch(&candidates_[end_voxel[i + kPointsAhead]], 1);
+      }
+    };
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& range) {
                         for (size_t i = range.begin(); i != range.end(); ++i) {
@@ -199,6 +206,9 @@ class CpuIntegrator final : public Integrator {
                           end_voxel[i] = geometry_.voxel_in_map(rays.endpoints_m[i], v)
                                              ? geometry_.linear(v)
                                              : kOutside;
+                        }
+                        for (size_t i = range.begin(); i != range.end(); ++i) {
+                          prefetch_ahead(i, range.end());
                           if (end_voxel[i] != kOutside) {
                             atomic_min(candidates_[end_voxel[i]], static_cast<uint32_t>(i));
                           }
@@ -210,6 +220,7 @@ class CpuIntegrator final : public Integrator {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& range) {
                         for (size_t i = range.begin(); i != range.end(); ++i) {
+                          prefetch_ahead(i, range.end());
                           if (end_voxel[i] == kOutside) {
                             keep[i] = 1;
                             continue;
