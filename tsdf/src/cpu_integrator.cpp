@@ -450,8 +450,9 @@ class CpuIntegrator final : public Integrator {
       part.free_walks.clear();
     }
 
-    /// Free space passed in the voxels of `passed_word` that `passed` names (where the walk's
-    /// free-space loop hands it over a word at a time, free_space_walk.hpp).
+    /// Free space passed in the voxels of `passed_word` that `passed` names (where free space
+    /// comes a word at a time: from the walk's free-space loop, free_space_walk.hpp, or from
+    /// the lanes through the word table, finish()).
     void free_word(size_t passed_word, uint64_t passed) {
       if (passed == 0) return;
       const uint64_t fresh = passed & ~self.settled_[passed_word];

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 
+#include "cpu_features.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -100,8 +101,7 @@ inline uint64_t fuse_free_space_word(uint32_t* voxels, uint64_t bits, uint64_t s
                                      uint32_t weight, uint32_t max_weight, uint32_t settled_voxel) {
   if (weight == 0u) return settled;  // fuse leaves every voxel as it is
 #if FEATSENSE_FREE_SPACE_FUSION_AVX2
-  static const bool has_avx2 = __builtin_cpu_supports("avx2") != 0;
-  if (has_avx2) {
+  if (cpu_has_avx2()) {
     return fuse_free_space_word_avx2(voxels, bits, settled, weight, max_weight, settled_voxel);
   }
 #endif

@@ -4,6 +4,8 @@
 
 #include <limits>
 
+#include "cpu_features.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define FEATSENSE_FREE_SPACE_LANES_AVX2 1
@@ -102,7 +104,7 @@ struct FreeSpaceLanes::State {
   alignas(32) int32_t next[3][kLanes];     ///< the next crossing per axis (ticks)
   alignas(32) int32_t delta[3][kLanes];    ///< ticks between crossings
   alignas(32) int32_t place[kLanes];       ///< the voxel in its brick (kPlaceBias)
-  alignas(32) int32_t left[kLanes];        ///< voxels left to visit; <= 0: no walk
+  alignas(32) int32_t left[kLanes] = {};   ///< voxels left to visit; <= 0: no walk
   alignas(32) int32_t low[kLanes];         ///< the word's bits 0-31 gathered so far
   alignas(32) int32_t high[kLanes];        ///< bits 32-63
   alignas(32) int32_t brick[kLanes];       ///< storage brick
@@ -264,20 +266,12 @@ __attribute__((target("avx2,popcnt"))) bool FreeSpaceLanes::State::walk_avx2(
 bool FreeSpaceLanes::State::walk_avx2(FreeSpaceLanes::Words&) { return false; }
 #endif
 
-bool FreeSpaceLanes::supported() {
-#if FEATSENSE_FREE_SPACE_LANES_AVX2
-  static const bool has_avx2 = __builtin_cpu_supports("avx2") != 0;
-  return has_avx2;
-#else
-  return false;
-#endif
-}
+bool FreeSpaceLanes::supported() { return FEATSENSE_FREE_SPACE_LANES_AVX2 && cpu_has_avx2(); }
 
 FreeSpaceLanes::FreeSpaceLanes() : state_(std::make_unique<State>()) {
   out_.word.resize(kWordCapacity + kLanes);
   out_.low.resize(kWordCapacity + kLanes);
   out_.high.resize(kWordCapacity + kLanes);
-  for (int l = 0; l < kLanes; ++l) state_->left[l] = 0;
 }
 FreeSpaceLanes::~FreeSpaceLanes() = default;
 FreeSpaceLanes::FreeSpaceLanes(FreeSpaceLanes&&) noexcept = default;
