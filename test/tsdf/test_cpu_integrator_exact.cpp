@@ -1,9 +1,9 @@
 // The CPU integrator's exact output, bit for bit. The CUDA backend is checked against the CPU
 // integrator on the GPU machine, so any change to the CPU map (a voxel value, a weight, a
 // count) breaks that parity even where no test here would notice. Two checks per case:
-// - against a brute-force integrator written here (one thread, a plain minimum, fusion of a
-//   list of touched voxels), which shares only ray_marcher.hpp and voxel.hpp, the definitions
-//   the CUDA kernels compile too;
+// - against the reference integrator (reference_integrator.hpp: one thread, a plain minimum,
+//   fusion of a list of touched voxels), which shares only ray_marcher.hpp and voxel.hpp with
+//   the fast integrators, the definitions the CUDA kernels compile too;
 // - against hashes of the map and stats recorded with the integrator as it was before its
 //   speed work (commit 51f32ca), so a change of the shared definitions shows up as well.
 //   Recorded again where the walks began to measure t in integer ticks (ray_marcher.hpp,
@@ -19,10 +19,10 @@
 #include <limits>
 #include <random>
 #include <set>
-#include <unordered_set>
 
 #include "analytic_rays.hpp"
 #include "box_room_rays.hpp"
+#include "featsense/tsdf/reference_integrator.hpp"
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
 #include "tsdf_test_support.hpp"
@@ -31,81 +31,20 @@
 namespace featsense::tsdf {
 namespace {
 
-/// The straightforward integrator: the rules of tsdf/README.md with nothing clever.
-class BruteForceIntegrator {
- public:
-  BruteForceIntegrator(const TsdfSettings& settings, Vec3 centre_m)
-      : settings_(settings),
-        geometry_(centred_geometry(settings, centre_m)),
-        map_(geometry_.voxel_count(), kUnobservedVoxel),
-        candidates_(geometry_.voxel_count(), kEmptyCandidate) {}
-
-  IntegrationStats integrate(const RayBatch& rays) {
-    detail::RayMarchParams params;
-    params.truncation_m = settings_.truncation_m;
-    params.interpolation_slope = settings_.interpolation_slope;
-    params.up = rays.up;
-    IntegrationStats stats;
-    std::unordered_set<size_t> end_voxels;  // voxels that already have their first point
-    std::vector<size_t> touched;
-    for (size_t i = 0; i < rays.size(); ++i) {
-      Index3 v;
-      if (settings_.reduce_points_per_voxel && geometry_.voxel_in_map(rays.endpoints_m[i], v) &&
-          !end_voxels.insert(geometry_.linear(v)).second) {
-        continue;
-      }
-      ++stats.rays;
-      detail::RayMarchParams ray_params = params;
-      if (!rays.may_interpolate(i)) ray_params.interpolation_slope = 0.0f;
-      ray_params.carve_from_m = detail::carving_start(
-          settings_.carve_free_space, settings_.dense_range_m, rays.carving_level_of(i));
-      detail::march_ray(rays.origin(i), rays.endpoints_m[i], geometry_, ray_params,
-                        [&](size_t index, int32_t value, bool interpolated) {
-                          if (candidates_[index] == kEmptyCandidate) touched.push_back(index);
-                          candidates_[index] =
-                              std::min(candidates_[index], make_candidate(value, interpolated));
-                        });
-    }
-    // Settled free space (+tau at the weight cap) stays as it is when this scan's best
-    // candidate for it is +tau or interpolated, and is not counted as updated.
-    const uint32_t settled = settled_free_voxel(settings_.max_weight_fixed());
-    for (const size_t index : touched) {
-      const uint32_t key = candidates_[index];
-      candidates_[index] = kEmptyCandidate;
-      const int32_t value = candidate_value(key);
-      if (map_[index] == settled && (value == kValueScale || candidate_interpolated(key))) {
-        continue;
-      }
-      ++stats.voxels_updated;
-      const uint32_t weight = candidate_weight(value, settings_.falloff_start_fixed());
-      map_[index] = pack(fuse(unpack(map_[index]), value, weight, settings_.max_weight_fixed()));
-    }
-    return stats;
-  }
-
-  const std::vector<uint32_t>& map() const { return map_; }
-
- private:
-  TsdfSettings settings_;
-  LocalMapGeometry geometry_;
-  std::vector<uint32_t> map_;
-  std::vector<uint32_t> candidates_;
-};
-
 /// FNV-1a over 32-bit words.
 uint64_t fnv1a(uint64_t hash, uint64_t word) {
   hash ^= word;
   return hash * 0x100000001b3ull;
 }
 
-/// Integrates `scans` with the CPU integrator and the brute-force one, expects the same map
+/// Integrates `scans` with the CPU integrator and the reference one, expects the same map
 /// and stats after every scan, and returns a hash of the CPU integrator's maps and stats.
 /// `updated`, if given, receives each scan's count of updated voxels.
-uint64_t expect_same_as_brute_force(const TsdfSettings& settings, Vec3 centre_m,
-                                    const std::vector<RayBatch>& scans,
-                                    std::vector<size_t>* updated = nullptr) {
+uint64_t expect_same_as_reference(const TsdfSettings& settings, Vec3 centre_m,
+                                  const std::vector<RayBatch>& scans,
+                                  std::vector<size_t>* updated = nullptr) {
   auto cpu = make_cpu_integrator(settings, centre_m);
-  BruteForceIntegrator reference(settings, centre_m);
+  ReferenceIntegrator reference(settings, centre_m);
   uint64_t hash = 0xcbf29ce484222325ull;
   for (const RayBatch& scan : scans) {
     const IntegrationStats a = cpu->integrate(scan);
@@ -140,16 +79,15 @@ TsdfSettings settings_of_the_hashes() {
 TEST(CpuIntegratorExact, IndoorDefaultMapInterpolationReduction) {
   TsdfSettings s = settings_of_the_hashes();  // the 40 x 40 x 15 m map at 6.4 cm
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(
-      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, false)),
-      0x56f0ec1ec7433416ull);
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, false)),
+            0x56f0ec1ec7433416ull);
 }
 
 TEST(CpuIntegratorExact, OutdoorRaysLeaveTheMap) {
   TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {20.0f, 16.0f, 8.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, true)),
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(3, true)),
             0x644262c315719dceull);
 }
 
@@ -157,18 +95,16 @@ TEST(CpuIntegratorExact, EveryRayNoInterpolation) {
   TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {24.0f, 24.0f, 8.0f};
   s.reduce_points_per_voxel = false;
-  EXPECT_EQ(
-      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
-      0xdb44c65456707cbcull);
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
+            0xdb44c65456707cbcull);
 }
 
 TEST(CpuIntegratorExact, EveryRayWithInterpolation) {
   TsdfSettings s = test::small_map_settings();
   s.reduce_points_per_voxel = false;
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(
-      expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
-      0x632eb59c678b29bdull);
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false)),
+            0x632eb59c678b29bdull);
 }
 
 TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
@@ -181,9 +117,9 @@ TEST(CpuIntegratorExact, RaysThatMayNotInterpolate) {
     scan.interpolate.resize(scan.size());
     for (size_t i = 0; i < scan.size(); ++i) scan.interpolate[i] = i % 3 == 0 ? 0 : 1;
   }
-  const uint64_t flagged = expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans);
+  const uint64_t flagged = expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), scans);
   for (RayBatch& scan : scans) scan.interpolate.clear();
-  EXPECT_NE(flagged, expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans));
+  EXPECT_NE(flagged, expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), scans));
 }
 
 TEST(CpuIntegratorExact, SparseCarving) {
@@ -192,12 +128,12 @@ TEST(CpuIntegratorExact, SparseCarving) {
   TsdfSettings s = TsdfSettings::from_config(config::MapConfig{}, config::sensor_preset("os1-128"));
   ASSERT_GT(s.dense_range_m, 1.0f);
   s.map_size_m = {24.0f, 24.0f, 8.0f};
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
   s.dense_range_m *= 4.0f;  // most of the room within the dense range
   s.reduce_points_per_voxel = false;
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
   s.carve_free_space = false;  // the band only
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_rays(2, false, true));
 }
 
 TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
@@ -205,14 +141,14 @@ TEST(CpuIntegratorExact, RaysFromOutsideTheMap) {
   TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {8.0f, 8.0f, 4.0f};
   s.interpolation_slope = os1_interpolation_slope();
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(5, 2, 1.0), test::box_room_rays(2, false)),
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(5, 2, 1.0), test::box_room_rays(2, false)),
             0x4761511e2fed3bc0ull);
 }
 
 TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
   // The CPU integrator shares the map out among sectors by its thread count: one thread
   // (eight sectors), seven (56 sectors, more candidates handed between them) and forty (as many
-  // sectors as a brick's owner byte allows, 255) must give the same map as the brute-force
+  // sectors as a brick's owner byte allows, 255) must give the same map as the reference
   // integrator.
   TsdfSettings s = settings_of_the_hashes();
   s.map_size_m = {16.0f, 16.0f, 6.0f};
@@ -221,7 +157,7 @@ TEST(CpuIntegratorExact, SameMapWithAnyNumberOfThreads) {
   for (const int threads : {1, 7, 40}) {
     tbb::task_arena arena(threads);
     arena.execute([&] {
-      EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), scans),
+      EXPECT_EQ(expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), scans),
                 0xe1dc5e336dc1c7b3ull)
           << threads << " threads";
     });
@@ -252,20 +188,20 @@ TEST(CpuIntegratorExact, RepeatedScansReachTheWeightCapWithOneOrigin) {
   // Recorded after settled free space was passed by (the maps were those of the hash before,
   // 0x6708b25316a676c5 at commit 51f32ca, the counts of updated voxels smaller once the
   // weights reach the cap), and again with the walks' integer ticks.
-  EXPECT_EQ(expect_same_as_brute_force(s, test::make_vec(0, 0, 1), scans), 0x7ae498c2842b45a9ull);
+  EXPECT_EQ(expect_same_as_reference(s, test::make_vec(0, 0, 1), scans), 0x7ae498c2842b45a9ull);
 }
 
 TEST(CpuIntegratorExact, SettledFreeSpaceIsPassedBy) {
   TsdfSettings s = test::small_map_settings();
   s.max_weight = 2.0f;
   std::vector<size_t> updated;
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3), &updated);
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3), &updated);
   // Once the free space is settled, a scan updates little more than its truncation band.
   EXPECT_LT(updated.back() * 3, updated.front());
   // With vertical interpolation, whose candidates settled free space passes by as well (a
   // wide band, so that rays of the small room interpolate at 0.1 m voxels).
   s.interpolation_slope = 0.03f;
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3));
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3));
 }
 
 TEST(CpuIntegratorExact, SettledFreeSpaceAtTheDefaultVoxelSize) {
@@ -276,7 +212,7 @@ TEST(CpuIntegratorExact, SettledFreeSpaceAtTheDefaultVoxelSize) {
   s.max_weight = 2.0f;
   s.interpolation_slope = os1_interpolation_slope();
   std::vector<size_t> updated;
-  expect_same_as_brute_force(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3), &updated);
+  expect_same_as_reference(s, test::make_vec(-2, 0, 1.5), test::box_room_passes(2, 3), &updated);
   EXPECT_LT(updated.back() * 3, updated.front());
 }
 
