@@ -145,65 +145,97 @@ FEATSENSE_HD_INLINE bool clip_to_box(Vec3 origin, Vec3 dir, Vec3 lo, Vec3 hi, fl
   return t0 < t1;
 }
 
+/// A ray made ready for its walk: what every walk of it (march_ray, walk_ray; the CPU's and the
+/// GPU's) starts from, computed once here, so that they all start from the same bits.
+struct RaySetup {
+  float range;            ///< from the origin to the end point (metres)
+  Vec3 dir;               ///< unit, from the origin towards the end point
+  bool interpolate;       ///< whether the ray fills voxels above and below it near the surface
+  Vec3 across;            ///< the unit direction of that filling, where interpolate
+  float t_start;          ///< the ray's t where the walk starts: tau behind the end point or
+                          ///< where the ray leaves the map, whichever comes first
+  WalkClock clock;        ///< the walk's ticks
+  int32_t end_ticks;      ///< the walk's end (walk_end), in ticks from its start
+  Index3 voxel;           ///< the walk's first voxel (global index; may lie outside the map)
+  AxisCrossings axes[3];  ///< the walk's face crossings along x, y and z
+};
+
+/// Sets `ray` up for the ray from `origin` to `endpoint` (map frame, metres); false for a ray
+/// that proposes nothing: NaN, zero or infinite (a NaN or absurd point or origin), or one that
+/// misses the local map.
+FEATSENSE_HD_INLINE bool setup_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
+                                   const RayMarchParams& params, RaySetup& ray) {
+  const Vec3 delta = endpoint - origin;
+  ray.range = norm(delta);
+  if (!(ray.range > 0.0f && ray.range < 1.0e30f)) return false;
+  ray.dir = (1.0f / ray.range) * delta;
+  float t0 = 0.0f;
+  float t1 = ray.range + params.truncation_m;
+  if (!clip_to_box(origin, ray.dir, map.min_corner(), map.max_corner(), t0, t1)) return false;
+
+  // Interpolation direction: int = d x (d x up), in the plane of the ray and the sensor's up.
+  ray.across = cross(ray.dir, cross(ray.dir, params.up));
+  const float across_length = norm(ray.across);
+  ray.interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
+  if (ray.interpolate) ray.across = (1.0f / across_length) * ray.across;
+
+  // The walk goes from the far end back to the sensor (march_ray says why), measured in ticks
+  // of the distance from its start to the origin.
+  const float vs = map.voxel_size_m;
+  const Vec3 walk_start = origin + t1 * ray.dir;
+  const Vec3 walk_dir = -1.0f * ray.dir;
+  const float walk_length = t1 - walk_end(t0, ray.range, params, vs);
+  ray.t_start = t1;
+  ray.clock = WalkClock{static_cast<float>(kWalkTicks) / t1};
+  ray.end_ticks = ray.clock.ticks(walk_length);
+  ray.voxel = map.voxel_of(walk_start);
+  for (int axis = 0; axis < 3; ++axis) {
+    ray.axes[axis] = axis_crossings(component(walk_start, axis), component(walk_dir, axis),
+                                    component(ray.voxel, axis), vs, ray.clock);
+  }
+  return true;
+}
+
 /// Calls visit(linear_index, value_fixed, interpolated) for each candidate of the ray from `origin`
 /// to `endpoint` (map frame, metres). Voxels outside the local map are never visited. The
-/// plain statement of the rule: the integrators run walk_ray (ray_walk.hpp), which proposes the
-/// same candidates with less work, and the tests check it against this.
+/// plain statement of the rule: the reference integrator walks its rays with it; the fast
+/// integrators run walk_ray (ray_walk.hpp), which proposes the same candidates with less work,
+/// and the tests check it against this.
 template <typename Visit>
 FEATSENSE_HD_INLINE void march_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
                                    const RayMarchParams& params, Visit&& visit) {
-  const Vec3 delta = endpoint - origin;
-  const float range = norm(delta);
-  // NaN, zero and infinite rays (a NaN or absurd point or origin) propose nothing.
-  if (!(range > 0.0f && range < 1.0e30f)) return;
-  const Vec3 dir = (1.0f / range) * delta;
-  float t0 = 0.0f;
-  float t1 = range + params.truncation_m;
-  if (!clip_to_box(origin, dir, map.min_corner(), map.max_corner(), t0, t1)) return;
-
-  // Interpolation direction: int = d x (d x up), in the plane of the ray and the sensor's up.
-  Vec3 across = cross(dir, cross(dir, params.up));
-  const float across_length = norm(across);
-  const bool interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
-  if (interpolate) across = (1.0f / across_length) * across;
+  RaySetup ray;
+  if (!setup_ray(origin, endpoint, map, params, ray)) return;
 
   // Amanatides & Woo traversal from the far end back to the sensor. Every ray passes the
   // few voxels next to the sensor; walking towards them, rays arrive there at different
   // times and mostly find them already carved, instead of all contending for them at once.
-  const float vs = map.voxel_size_m;
-  const Vec3 walk_start = origin + t1 * dir;
-  const Vec3 walk_dir = -1.0f * dir;
-  const float walk_length = t1 - walk_end(t0, range, params, vs);
-  const WalkClock clock{static_cast<float>(kWalkTicks) / t1};
-  const int32_t walk_end_ticks = clock.ticks(walk_length);
-  Index3 voxel = map.voxel_of(walk_start);
+  Index3 voxel = ray.voxel;
   int32_t step[3];
   int32_t t_next[3];  // ticks
   int32_t t_delta[3];
   for (int axis = 0; axis < 3; ++axis) {
-    const AxisCrossings c = axis_crossings(component(walk_start, axis), component(walk_dir, axis),
-                                           component(voxel, axis), vs, clock);
-    step[axis] = c.step;
-    t_next[axis] = c.first;
-    t_delta[axis] = c.delta;
+    step[axis] = ray.axes[axis].step;
+    t_next[axis] = ray.axes[axis].first;
+    t_delta[axis] = ray.axes[axis].delta;
   }
 
   const float tau = params.truncation_m;
   int32_t t = 0;
   // Bounded by the number of voxels a segment can cross, so rounding can never loop forever.
   const int32_t max_steps = map.dim.x + map.dim.y + map.dim.z + 3;
-  for (int32_t i = 0; i < max_steps && t <= walk_end_ticks; ++i) {
+  for (int32_t i = 0; i < max_steps && t <= ray.end_ticks; ++i) {
     if (map.contains(voxel)) {
       const Vec3 centre = map.centre_of(voxel);
-      const float along = dot(centre - origin, dir);
-      const float distance = range - along;
+      const float along = dot(centre - origin, ray.dir);
+      const float distance = ray.range - along;
       if (distance >= -tau) {
         const int32_t value = distance_to_fixed(distance, tau);
         visit(map.linear(voxel), value, false);
         // Fill between the scan lines only near the surface: free space far in front is
         // carved by the rays themselves, and widening every ray there costs more than it gives.
-        if (interpolate && distance < tau) {
-          for_each_interpolated_voxel(map, centre, across, params.interpolation_slope * along,
+        if (ray.interpolate && distance < tau) {
+          for_each_interpolated_voxel(map, centre, ray.across, params.interpolation_slope * along,
                                       [&](Index3 g) { visit(map.linear(g), value, true); });
         }
       }

@@ -64,26 +64,11 @@ template <typename Visit>
 FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeometry& map,
                                   const RayMarchParams& params, Visit&& visit,
                                   const uint8_t* settled_bricks = nullptr, WalkPart part = {}) {
-  const Vec3 delta = endpoint - origin;
-  const float range = norm(delta);
-  if (!(range > 0.0f && range < 1.0e30f)) return;
-  const Vec3 dir = (1.0f / range) * delta;
-  float t0 = 0.0f;
-  float t1 = range + params.truncation_m;
-  if (!clip_to_box(origin, dir, map.min_corner(), map.max_corner(), t0, t1)) return;
-
-  Vec3 across = cross(dir, cross(dir, params.up));
-  const float across_length = norm(across);
-  const bool interpolate = params.interpolation_slope > 0.0f && across_length > 1e-6f;
-  if (interpolate) across = (1.0f / across_length) * across;
-
-  const float vs = map.voxel_size_m;
-  const Vec3 walk_start = origin + t1 * dir;
-  const Vec3 walk_dir = -1.0f * dir;
-  const float walk_length = t1 - walk_end(t0, range, params, vs);
-  const WalkClock clock{static_cast<float>(kWalkTicks) / t1};
-  const int32_t walk_end_ticks = clock.ticks(walk_length);
-  const Index3 start = map.voxel_of(walk_start);
+  RaySetup ray;
+  if (!setup_ray(origin, endpoint, map, params, ray)) return;
+  const float range = ray.range;
+  const Vec3 dir = ray.dir;
+  const int32_t walk_end_ticks = ray.end_ticks;
   const Index3 nb = map.bricks();
   const Index3 lowest_slot = map.wrapped_brick(map.origin);
 
@@ -96,9 +81,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
   int32_t base[3] = {};
   int32_t crossings = 0;  // face crossings up to the walk's end
   for (int axis = 0; axis < 3; ++axis) {
-    const int32_t v = component(start, axis);
-    const AxisCrossings c =
-        axis_crossings(component(walk_start, axis), component(walk_dir, axis), v, vs, clock);
+    const AxisCrossings c = ray.axes[axis];
     step[axis] = c.step;
     // An axis the walk runs parallel to is never stepped along: its crossing never comes.
     t_next[axis] = c.step != 0 ? c.first : INT32_MAX;
@@ -106,7 +89,7 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     if (c.step != 0 && c.first <= walk_end_ticks) {
       crossings += (walk_end_ticks - c.first) / c.delta + 1;
     }
-    offset[axis] = v - component(map.origin, axis);
+    offset[axis] = component(ray.voxel, axis) - component(map.origin, axis);
     dim[axis] = component(map.dim, axis);
     base[axis] = component(lowest_slot, axis) * kBrickSize;
   }
@@ -188,7 +171,8 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
 
   const float tau = params.truncation_m;
 
-  const int32_t free_from = clock.ticks(free_space_from(t1, range, tau, vs));
+  const int32_t free_from =
+      ray.clock.ticks(free_space_from(ray.t_start, range, tau, map.voxel_size_m));
   // Jumps from the current voxel to the first one after its brick (brick_exit). Returns the
   // steps taken (-1: none possible).
   const auto leave_brick = [&]() -> int32_t {
@@ -305,9 +289,9 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
           } else if (distance >= -tau) {
             const int32_t value = distance_to_fixed(distance, tau);
             visit(index, value, false);
-            if (interpolate) {
+            if (ray.interpolate) {
               for_each_interpolated_voxel(
-                  map, centre, across, params.interpolation_slope * along, [&](Index3 v) {
+                  map, centre, ray.across, params.interpolation_slope * along, [&](Index3 v) {
                     visit(static_cast<WalkIndex>(linear_of_contained(v)), value, true);
                   });
             }
