@@ -24,13 +24,18 @@ namespace featsense::tsdf {
 namespace {
 
 /// Takes every candidate, free space as words: what the walk hands over, folded into one
-/// value so that nothing is optimised away.
+/// value so that nothing is optimised away. The free space at the end of each walk is walked
+/// at once by the scalar loop.
 struct WordSink {
-  static constexpr bool kTakesFreeWords = true;
+  static constexpr bool kTakesFreeWalks = true;
+  detail::FreeSpaceMap map{};
   uint64_t folded = 0;
   size_t words = 0;
   void operator()(size_t index, int32_t value, bool interpolated) {
     folded += index * 31u + static_cast<uint32_t>(value) + (interpolated ? 1u : 0u);
+  }
+  void free_walk(const detail::FreeWalk& walk) {
+    detail::walk_free_space_job(walk, map, nullptr, *this);
   }
   void free_word(size_t word, uint64_t bits) {
     folded ^= word * 0x9E3779B97F4A7C15ull + bits;
@@ -48,7 +53,6 @@ struct VoxelSink {
 
 /// The same, the free space of the walks set aside and walked eight at a time.
 struct LaneSink : WordSink {
-  static constexpr bool kTakesFreeWalks = true;
   std::vector<detail::FreeWalk> walks;
   void free_walk(const detail::FreeWalk& walk) { walks.push_back(walk); }
 };
@@ -62,6 +66,7 @@ void walk_scan(benchmark::State& state) {
   params.truncation_m = settings.truncation_m;
   for (auto _ : state) {
     Sink sink;
+    if constexpr (std::is_base_of_v<WordSink, Sink>) sink.map = detail::FreeSpaceMap::of(map);
     for (size_t i = 0; i < scan.size(); ++i)
       detail::walk_ray(scan.origin(i), scan.endpoints_m[i], map, params, sink);
     if constexpr (std::is_same_v<Sink, LaneSink>) {

@@ -23,6 +23,7 @@
 #include "analytic_rays.hpp"
 #include "box_room_rays.hpp"
 #include "featsense/tsdf/reference_integrator.hpp"
+#include "free_space_walk.hpp"
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
 #include "tsdf_test_support.hpp"
@@ -403,19 +404,24 @@ struct Proposals {
   size_t words = 0;  // free space handed over as words
 };
 
-/// A visitor that takes free space as words (kTakesFreeWords), as the CPU integrator's does,
-/// leaving out what settled bricks pass by; march_ray, which hands it every voxel on its own,
-/// is recorded with the same visitor.
+/// A visitor that takes the free space at the end of a walk whole (kTakesFreeWalks) and walks
+/// it as words with the scalar loop, as the CPU integrator does where the processor has no
+/// AVX2, leaving out what settled bricks pass by; march_ray, which hands it every voxel on its
+/// own, is recorded with the same visitor.
 struct FreeWordVisitor {
-  static constexpr bool kTakesFreeWords = true;
+  static constexpr bool kTakesFreeWalks = true;
   Proposals* out;
   const uint8_t* bricks;
+  detail::FreeSpaceMap map;
   void operator()(size_t index, int32_t value, bool interpolated) {
     if (value == kValueScale && !interpolated) {
       free(index);
     } else {
       out->other.push_back({index, value, interpolated});
     }
+  }
+  void free_walk(const detail::FreeWalk& walk) {
+    detail::walk_free_space_job(walk, map, bricks, *this);
   }
   void free_word(size_t word, uint64_t bits) {
     ++out->words;
@@ -428,10 +434,10 @@ struct FreeWordVisitor {
 };
 
 TEST(CpuIntegratorExact, FreeSpaceWalkedAsWordsIsTheWalksFreeSpace) {
-  // Where a visitor takes free space as words, the CPU walks the free space at the end of a
-  // walk in a loop of its own (free_space_walk.hpp). The free space it proposes must be exactly
-  // the set march_ray proposes (less what settled bricks pass by), and every other candidate
-  // the same, in the same order. Rays along diagonals from brick corners tie at every
+  // Where the processor has no AVX2, the CPU walks the free space at the end of a walk in a
+  // loop of its own (free_space_walk.hpp), which hands it on as words. The free space it proposes
+  // must be exactly the set march_ray proposes (less what settled bricks pass by), and every other
+  // candidate the same, in the same order. Rays along diagonals from brick corners tie at every
   // crossing; steep rays step along z most; rays from outside the map, ending beyond it, with
   // sparse carving, with and without settled bricks.
   TsdfSettings s;
@@ -453,8 +459,10 @@ TEST(CpuIntegratorExact, FreeSpaceWalkedAsWordsIsTheWalksFreeSpace) {
     for (const uint8_t* bricks : brick_sets) {
       Proposals reference;
       Proposals walk;
-      detail::march_ray(origin, endpoint, map, params, FreeWordVisitor{&reference, bricks});
-      FreeWordVisitor visitor{&walk, bricks};
+      const detail::FreeSpaceMap free_map = detail::FreeSpaceMap::of(map);
+      detail::march_ray(origin, endpoint, map, params,
+                        FreeWordVisitor{&reference, bricks, free_map});
+      FreeWordVisitor visitor{&walk, bricks, free_map};
       detail::walk_ray(origin, endpoint, map, params, visitor, bricks);
       free_voxels += reference.free.size();
       words += walk.words;

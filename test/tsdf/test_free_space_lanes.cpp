@@ -45,14 +45,12 @@ struct MarchVisitor {
 
 /// The walk's, the free space at the end of each walk set aside.
 struct WalkVisitor {
-  static constexpr bool kTakesFreeWords = true;
   static constexpr bool kTakesFreeWalks = true;
   FreeSet* free;
   std::vector<detail::FreeWalk>* walks;
   void operator()(size_t index, int32_t value, bool interpolated) {
     if (value == kValueScale && !interpolated) free->add(index);
   }
-  void free_word(size_t word, uint64_t bits) { free->add_word(word, bits); }
   void free_walk(const detail::FreeWalk& walk) { walks->push_back(walk); }
 };
 

@@ -389,7 +389,6 @@ class CpuIntegrator final : public Integrator {
   /// free space left out. A free-space step so touches no memory; the fusion takes
   /// min(candidate, +tau) where a bit is set, as if each visit had proposed +tau.
   struct SectorVisitor {
-    static constexpr bool kTakesFreeWords = true;  // free_word, below
     static constexpr bool kTakesFreeWalks = true;  // free_walk, below
     CpuIntegrator& self;
     size_t p;

@@ -17,7 +17,7 @@
 // every visitor of free words drops settled voxels (the jump only saves time).
 //
 // Where the processor has no AVX2 (chosen at run time; the build targets baseline x86-64),
-// walk_free_space_job walks one set-aside walk with the scalar loop.
+// walk_free_space_job (free_space_walk.hpp) walks one set-aside walk with the scalar loop.
 
 #include <cstddef>
 #include <cstdint>
@@ -27,51 +27,6 @@
 #include "free_space_walk.hpp"
 
 namespace featsense::tsdf::detail {
-
-/// The map as a free-space walk sees it: bricks per axis, and the ring buffer's slot of the
-/// map's lowest brick.
-struct FreeSpaceMap {
-  int32_t bricks[3];
-  int32_t lowest_slot[3];
-
-  static FreeSpaceMap of(const LocalMapGeometry& map) {
-    const Index3 nb = map.bricks();
-    const Index3 lowest = map.wrapped_brick(map.origin);
-    return {{nb.x, nb.y, nb.z}, {lowest.x, lowest.y, lowest.z}};
-  }
-  /// The storage brick of a voxel of the map (offset: global index less the lowest corner).
-  int32_t brick_of(const int32_t offset[3]) const {
-    int32_t slot[3];
-    for (int axis = 0; axis < 3; ++axis) {
-      const int32_t s = lowest_slot[axis] + (offset[axis] >> kBrickShift);
-      slot[axis] = s >= bricks[axis] ? s - bricks[axis] : s;
-    }
-    return (slot[2] * bricks[1] + slot[1]) * bricks[0] + slot[0];
-  }
-  bool contains(const int32_t offset[3]) const {
-    for (int axis = 0; axis < 3; ++axis) {
-      if (static_cast<uint32_t>(offset[axis]) >= static_cast<uint32_t>(bricks[axis] * kBrickSize)) {
-        return false;
-      }
-    }
-    return true;
-  }
-};
-
-/// Walks a set-aside walk with the scalar loop (walk_free_space_words), settled bricks jumped
-/// across: `visit.free_word(word, bits)` for its free space.
-template <typename Visit>
-void walk_free_space_job(FreeWalk walk, const FreeSpaceMap& map, const uint8_t* settled_bricks,
-                         Visit& visit) {
-  const auto storage_index = [&] {
-    const auto place = [&](int axis) { return walk.offset[axis] & (kBrickSize - 1); };
-    return int64_t{map.brick_of(walk.offset)} * kBrickVoxels +
-           (place(2) * kBrickSize + place(1)) * kBrickSize + place(0);
-  };
-  const auto contains = [&] { return map.contains(walk.offset); };
-  walk_free_space_words(walk.offset, walk.t_next, walk.t_delta, walk.step, 0, walk.turns,
-                        settled_bricks, storage_index, contains, visit);
-}
 
 /// Walks set-aside walks eight at a time (see above). Its state and output live across calls:
 ///   lanes.start(walks, count, map);

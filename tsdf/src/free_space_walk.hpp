@@ -1,8 +1,10 @@
 #pragma once
-// The CPU's walk through the rest of a ray once it is free space: the voxels march_ray would
-// visit, each a free-space candidate (+tau), handed to the visitor as bits of 64-voxel words
-// (free_word) instead of one call per voxel. The general walk (ray_walk.hpp) keeps some twenty
-// values alive per step and the CPU has sixteen registers, so its state lived on the stack;
+// The CPU's walk through the rest of a ray once it is free space (a FreeWalk that walk_ray
+// handed over, ray_walk.hpp): the voxels march_ray would visit, each a free-space candidate
+// (+tau), handed to the visitor as bits of 64-voxel words instead of one call per voxel:
+// `visit.free_word(word, bits)` for the voxels word * 64 + b, b a set bit, in any order and any
+// word more than once (the scan's minimum is the same). The general walk (ray_walk.hpp) keeps some
+// twenty values alive per step and the CPU has sixteen registers, so its state lived on the stack;
 // this loop keeps only what free space needs: the three next crossings, the place in the
 // brick and the word's bits. Inside a brick a step moves the place by a constant, and only a
 // step along z starts a new word (a word is 8 x 8 voxels of one z layer); the storage index,
@@ -11,47 +13,17 @@
 // Exact: the same steps in the same order as the general walk (the lower axis first on
 // ties), the same jumps across settled bricks (brick_exit), the same turns.
 
-#include <type_traits>
+#include <cstdint>
 
 #include "brick_exit.hpp"
 #include "featsense/tsdf/local_map_geometry.hpp"
+#include "ray_walk.hpp"
 
 namespace featsense::tsdf::detail {
 
-/// Whether a walk's visitor takes free space as words: `free_word(word, bits)` for the voxels
-/// word * 64 + b, b a set bit, each proposing +tau (not interpolated), in any order and any
-/// word more than once (the scan's minimum is the same). A visitor says so with
-/// `static constexpr bool kTakesFreeWords = true;`.
-template <typename Visit, typename = void>
-struct TakesFreeWords : std::false_type {};
-template <typename Visit>
-struct TakesFreeWords<Visit, std::void_t<decltype(Visit::kTakesFreeWords)>>
-    : std::bool_constant<Visit::kTakesFreeWords> {};
-
-/// A walk's free space set aside, to be walked later with others (free_space_lanes.hpp): the
-/// walk's state at its current voxel (inside the map, not yet visited), from which every voxel
-/// up to the walk's end is free space.
-struct FreeWalk {
-  int32_t offset[3];   ///< the voxel: global index less the map's lowest corner
-  int32_t t_next[3];   ///< the next crossing per axis (ticks; INT32_MAX where never stepped)
-  int32_t t_delta[3];  ///< ticks between crossings per axis
-  int32_t step[3];     ///< -1, 0 or 1 per axis
-  int32_t turns;       ///< voxels left to visit, the current one included (>= 1)
-};
-
-/// Whether a walk's visitor takes the free space at the end of a walk as a whole:
-/// `free_walk(const FreeWalk&)` instead of free_word calls (which it must then make itself,
-/// for exactly the voxels walk_free_space_words would hand over, settled bricks aside). A
-/// visitor says so with `static constexpr bool kTakesFreeWalks = true;`.
-template <typename Visit, typename = void>
-struct TakesFreeWalks : std::false_type {};
-template <typename Visit>
-struct TakesFreeWalks<Visit, std::void_t<decltype(Visit::kTakesFreeWalks)>>
-    : std::bool_constant<Visit::kTakesFreeWalks> {};
-
 /// Walks from the current voxel (turn `turn`, inside the map, at the first voxel of a brick the
 /// walk enters, not yet visited) to the walk's end, where every voxel is free space. `offset`
-/// is the walk's: storage_index() and contains() read it (the general walk's functions).
+/// is the walk's: storage_index() and contains() read it.
 template <typename Visit, typename StorageIndex, typename Contains>
 inline void walk_free_space_words(int32_t offset[3], int32_t t_next[3], const int32_t t_delta[3],
                                   const int32_t step[3], int32_t turn, int32_t end_turn,
@@ -133,6 +105,51 @@ inline void walk_free_space_words(int32_t offset[3], int32_t t_next[3], const in
     offset[exit_axis] += step[exit_axis];
     if (!contains()) return;
   }
+}
+
+/// The map as a free-space walk sees it: bricks per axis, and the ring buffer's slot of the
+/// map's lowest brick.
+struct FreeSpaceMap {
+  int32_t bricks[3];
+  int32_t lowest_slot[3];
+
+  static FreeSpaceMap of(const LocalMapGeometry& map) {
+    const Index3 nb = map.bricks();
+    const Index3 lowest = map.wrapped_brick(map.origin);
+    return {{nb.x, nb.y, nb.z}, {lowest.x, lowest.y, lowest.z}};
+  }
+  /// The storage brick of a voxel of the map (offset: global index less the lowest corner).
+  int32_t brick_of(const int32_t offset[3]) const {
+    int32_t slot[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      const int32_t s = lowest_slot[axis] + (offset[axis] >> kBrickShift);
+      slot[axis] = s >= bricks[axis] ? s - bricks[axis] : s;
+    }
+    return (slot[2] * bricks[1] + slot[1]) * bricks[0] + slot[0];
+  }
+  bool contains(const int32_t offset[3]) const {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (static_cast<uint32_t>(offset[axis]) >= static_cast<uint32_t>(bricks[axis] * kBrickSize)) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+/// Walks a set-aside walk with the scalar loop (walk_free_space_words), settled bricks jumped
+/// across: `visit.free_word(word, bits)` for its free space.
+template <typename Visit>
+void walk_free_space_job(FreeWalk walk, const FreeSpaceMap& map, const uint8_t* settled_bricks,
+                         Visit& visit) {
+  const auto storage_index = [&] {
+    const auto place = [&](int axis) { return walk.offset[axis] & (kBrickSize - 1); };
+    return int64_t{map.brick_of(walk.offset)} * kBrickVoxels +
+           (place(2) * kBrickSize + place(1)) * kBrickSize + place(0);
+  };
+  const auto contains = [&] { return map.contains(walk.offset); };
+  walk_free_space_words(walk.offset, walk.t_next, walk.t_delta, walk.step, 0, walk.turns,
+                        settled_bricks, storage_index, contains, visit);
 }
 
 }  // namespace featsense::tsdf::detail

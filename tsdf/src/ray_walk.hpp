@@ -1,10 +1,10 @@
 #pragma once
-// The walk of one ray that both backends run: exactly the candidates of detail::march_ray
-// (ray_marcher.hpp, the plain statement of the rule, which the tests use as the reference),
-// computed with less work per voxel. The float operations that decide which voxels are
-// visited and what they get are the same ones in the same order, so the results are bit for
-// bit the same (test_cpu_integrator_exact checks it against march_ray itself); only
-// bookkeeping is cheaper:
+// The walk of one ray that both backends run (the CUDA kernels compile it too: no CPU-only
+// code here): exactly the candidates of detail::march_ray (ray_marcher.hpp, the plain
+// statement of the rule, which the tests use as the reference), computed with less work per
+// voxel. The float operations that decide which voxels are visited and what they get are the
+// same ones in the same order, so the results are bit for bit the same
+// (test_cpu_integrator_exact checks it against march_ray itself); only bookkeeping is cheaper:
 // - the storage index and the map-bounds test follow the traversal incrementally instead of
 //   being recomputed from the global index at every voxel, across brick faces too;
 // - the projective distance (march_ray's own expression) is computed only where a voxel may
@@ -15,16 +15,14 @@
 // - where the rest of the walk is free space, a brick of settled free space (voxel.hpp,
 //   settled_free_voxel), where every candidate would be passed by, is crossed in one jump
 //   (brick_exit), which computes the state that stepping through it would reach;
-// - on the CPU, for visitors that take free space as words (kTakesFreeWords), the free space
-//   at the end of the walk is walked by a loop of its own (free_space_walk.hpp), or handed
-//   to the visitor whole, to be walked together with other walks (free_space_lanes.hpp);
+// - on the CPU, a visitor may take the free space at the end of the walk whole (FreeWalk),
+//   which the CPU integrator walks with loops that know it is all free space (cpu_fast/);
 // - every array is indexed by constants only (one code path per stepped axis), so the
 //   traversal state stays in registers, on the GPU too (no local memory).
 
 #include <type_traits>
 
 #include "brick_exit.hpp"
-#include "free_space_walk.hpp"
 #include "ray_marcher.hpp"
 
 namespace featsense::tsdf::detail {
@@ -55,6 +53,28 @@ struct WalkPart {
   int32_t index = 0;
   int32_t count = 1;
 };
+
+/// The free space at the end of a walk, handed to a visitor whole (CPU only): the walk's state
+/// at its current voxel (inside the map, not yet visited), from which every voxel up to the
+/// walk's end is free space (+tau, measured, each).
+struct FreeWalk {
+  int32_t offset[3];   ///< the voxel: global index less the map's lowest corner
+  int32_t t_next[3];   ///< the next crossing per axis (ticks; INT32_MAX where never stepped)
+  int32_t t_delta[3];  ///< ticks between crossings per axis
+  int32_t step[3];     ///< -1, 0 or 1 per axis
+  int32_t turns;       ///< voxels left to visit, the current one included (>= 1)
+};
+
+/// Whether a walk's visitor takes the free space at the end of a walk whole:
+/// `free_walk(const FreeWalk&)` instead of a call per voxel, for it to propose +tau for exactly
+/// the voxels the rest of the walk would visit (those of settled bricks may be left out: they
+/// pass +tau by). A visitor says so with `static constexpr bool kTakesFreeWalks = true;`.
+/// Only the CPU's walk hands free space over; the GPU's visits every voxel.
+template <typename Visit, typename = void>
+struct TakesFreeWalks : std::false_type {};
+template <typename Visit>
+struct TakesFreeWalks<Visit, std::void_t<decltype(Visit::kTakesFreeWalks)>>
+    : std::bool_constant<Visit::kTakesFreeWalks> {};
 
 /// Calls visit(linear_index, value_fixed, interpolated) for every candidate march_ray would
 /// propose for this ray, in the same order, except the free-space candidates of the bricks
@@ -199,18 +219,17 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
     return settled_bricks != nullptr && inside ? settled_bricks[brick] : uint8_t{0};
   };
 #ifdef __CUDA_ARCH__
-  constexpr bool kFreeWords = false;
+  constexpr bool kFreeWalks = false;
 #else
-  // The CPU walks the free space at the end of a walk in a loop of its own, where the visitor
-  // takes free space as words (free_space_walk.hpp).
-  constexpr bool kFreeWords = TakesFreeWords<std::remove_reference_t<Visit> >::value;
+  // Where the visitor takes the free space at the end of a walk whole (FreeWalk).
+  constexpr bool kFreeWalks = TakesFreeWalks<std::remove_reference_t<Visit>>::value;
 #endif
-  // The walk's first brick and each one it enters, where it may jump or take the free space.
-  bool new_brick = settled_bricks != nullptr || kFreeWords;
+  // The walk's first brick and each one it enters, where it may jump or hand free space over.
+  bool new_brick = settled_bricks != nullptr || kFreeWalks;
   uint8_t brick_settled = settled_flag();
   const auto enter_brick = [&] {
     brick = index / kBrickVoxels;
-    new_brick = settled_bricks != nullptr || kFreeWords;
+    new_brick = settled_bricks != nullptr || kFreeWalks;
     brick_settled = settled_flag();
   };
   // The GPU computes the storage index from the offset after every step: a dozen instructions
@@ -247,23 +266,16 @@ FEATSENSE_HD_INLINE void walk_ray(Vec3 origin, Vec3 endpoint, const LocalMapGeom
       new_brick = false;
       // A brick inside the map lies wholly inside it (the map is whole bricks).
       jump = inside && in_free_space && brick_settled != 0;
-#ifndef __CUDA_ARCH__
-      if constexpr (kFreeWords) {
+      if constexpr (kFreeWalks) {
         if (inside && in_free_space) {
-          if constexpr (TakesFreeWalks<std::remove_reference_t<Visit> >::value) {
-            visit.free_walk(FreeWalk{{offset[0], offset[1], offset[2]},
-                                     {t_next[0], t_next[1], t_next[2]},
-                                     {t_delta[0], t_delta[1], t_delta[2]},
-                                     {step[0], step[1], step[2]},
-                                     end_turn - i});
-          } else {
-            walk_free_space_words(offset, t_next, t_delta, step, i, end_turn, settled_bricks,
-                                  storage_index, contains, visit);
-          }
+          visit.free_walk(FreeWalk{{offset[0], offset[1], offset[2]},
+                                   {t_next[0], t_next[1], t_next[2]},
+                                   {t_delta[0], t_delta[1], t_delta[2]},
+                                   {step[0], step[1], step[2]},
+                                   end_turn - i});
           return;
         }
       }
-#endif
     }
     // One if-else per turn, no early turn back to the loop's head: on the GPU, the lanes of a
     // warp then meet again at the end of every turn.
