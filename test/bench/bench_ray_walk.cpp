@@ -15,8 +15,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "cpu_fast/free_space_lanes.hpp"
 #include "featsense/tsdf/tsdf_settings.hpp"
-#include "free_space_lanes.hpp"
 #include "ray_walk.hpp"
 #include "tsdf/box_room_rays.hpp"
 

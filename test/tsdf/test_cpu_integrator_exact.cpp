@@ -22,8 +22,8 @@
 
 #include "analytic_rays.hpp"
 #include "box_room_rays.hpp"
+#include "cpu_fast/free_space_walk.hpp"
 #include "featsense/tsdf/reference_integrator.hpp"
-#include "free_space_walk.hpp"
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
 #include "tsdf_test_support.hpp"

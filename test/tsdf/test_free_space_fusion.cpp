@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "free_space_fusion.hpp"
+#include "cpu_fast/free_space_fusion.hpp"
 
 namespace featsense::tsdf {
 namespace {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "analytic_rays.hpp"
+#include "cpu_fast/free_space_lanes.hpp"
 #include "featsense/tsdf/tsdf_settings.hpp"
-#include "free_space_lanes.hpp"
 #include "ray_marcher.hpp"
 #include "ray_walk.hpp"
 #include "varied_rays.hpp"

@@ -7,7 +7,7 @@
 #include <map>
 #include <random>
 
-#include "free_word_cache.hpp"
+#include "cpu_fast/free_word_cache.hpp"
 
 namespace featsense::tsdf::detail {
 namespace {

@@ -15,11 +15,11 @@
 #include <memory>
 
 #include "brick_checks.hpp"
+#include "cpu_fast/free_space_fusion.hpp"
+#include "cpu_fast/free_space_lanes.hpp"
+#include "cpu_fast/free_word_cache.hpp"
+#include "cpu_fast/huge_page_allocator.hpp"
 #include "featsense/tsdf/integrator.hpp"
-#include "free_space_fusion.hpp"
-#include "free_space_lanes.hpp"
-#include "free_word_cache.hpp"
-#include "huge_page_allocator.hpp"
 #include "ray_walk.hpp"
 
 namespace featsense::tsdf {
