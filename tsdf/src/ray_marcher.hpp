@@ -1,8 +1,10 @@
 #pragma once
 // One ray's contribution to a scan's TSDF volume: a 3D DDA that visits every voxel the ray
 // crosses from where it enters the local map to tau behind its end point, with the
-// projective distance of each, and the vertical interpolation of the paper. Shared by the
-// CPU integrator and the CUDA kernel, so both propose exactly the same candidates.
+// projective distance of each, and the vertical interpolation of the paper: march_ray, which
+// the reference integrator and the tests walk rays with. The definitions it rests on (the
+// ray's setup, setup_ray; the walk's ticks; interpolation) are shared with the walk both fast
+// backends run (ray_walk.hpp), so all propose exactly the same candidates.
 
 #include <cfloat>
 

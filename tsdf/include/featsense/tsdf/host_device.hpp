@@ -1,6 +1,6 @@
 #pragma once
 /// Marks functions that both the CPU integrator and the CUDA kernels call, so the TSDF rule
-/// is written once (DESIGN.md: one definition, two backends).
+/// is written once: one definition, two backends.
 
 #if defined(__CUDACC__)
 #define FEATSENSE_HD __host__ __device__

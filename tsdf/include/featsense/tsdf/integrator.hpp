@@ -1,5 +1,6 @@
 #pragma once
-/// TSDF integration behind one interface, a CPU reference and a CUDA backend.
+/// TSDF integration behind one interface, a CPU and a CUDA backend; both give the map of the
+/// reference integrator (reference_integrator.hpp) bit for bit.
 
 #include <cstdint>
 #include <memory>
@@ -52,7 +53,7 @@ class Integrator {
   virtual void set_origin(Index3 origin) = 0;
 };
 
-/// The CPU reference integrator (TBB).
+/// The CPU integrator (TBB; src/cpu_integrator.hpp).
 std::unique_ptr<Integrator> make_cpu_integrator(const TsdfSettings& settings, Vec3 centre_m);
 
 /// True when this build has the CUDA backend and a usable GPU is present; else false with

@@ -14,8 +14,9 @@
 ///   bit 31      1 = interpolated, 0 = measured
 ///   bits 30..16 |value|
 ///   bit 15      1 = negative value (between +v and -v of equal size the positive wins)
-/// so the scan's winner is the integer minimum of all keys: one atomicMin on the GPU, a
-/// compare-exchange loop on the CPU, and the result does not depend on the order of rays.
+/// so the scan's winner is the integer minimum of all keys: one atomicMin on the GPU, a plain
+/// compare and store on the CPU (each voxel is written by the one task that owns its sector),
+/// and the result does not depend on the order of rays.
 /// kEmptyCandidate (all ones) is larger than every key.
 ///
 /// Fusion (paper eqs. 5-6) runs in integer arithmetic so that every backend gives the same
