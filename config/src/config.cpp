@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -60,14 +62,29 @@ void apply_document(Config& config, const YAML::Node& root, const std::string& o
     for (const auto& entry : section.second) {
       const std::string path = section_name + "." + entry.first.as<std::string>();
       const KeySpec* spec = find_key(path);
-      const std::string where = location(origin, entry.first) + ": " + path;
-      if (spec == nullptr) unknown_key(path, location(origin, entry.first));
-      spec->parse(config, entry.second, where);
+      const std::string line = location(origin, entry.first);
+      if (spec == nullptr) unknown_key(path, line);
+      spec->parse(config, entry.second, line + ": " + path);
+      config.explicit_keys[path] = line;
     }
   }
 }
 
-void apply_override(Config& config, const std::string& assignment) {
+/// Parses `value_text` as YAML into `key`; `where` starts every message, `origin` is
+/// recorded as where the key was set.
+void apply_value(Config& config, const KeySpec& spec, const std::string& value_text,
+                 const std::string& where, const std::string& origin) {
+  YAML::Node value;
+  try {
+    value = YAML::Load(value_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(where + ": cannot parse the value: " + e.msg);
+  }
+  spec.parse(config, value, where);
+  config.explicit_keys[spec.path] = origin;
+}
+
+void apply_assignment(Config& config, const std::string& assignment) {
   const std::string where = "--set " + assignment;
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
@@ -76,20 +93,21 @@ void apply_override(Config& config, const std::string& assignment) {
   const std::string path = assignment.substr(0, equals);
   const KeySpec* spec = find_key(path);
   if (spec == nullptr) unknown_key(path, "--set");
-  YAML::Node value;
-  try {
-    value = YAML::Load(assignment.substr(equals + 1));
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(where + ": cannot parse the value: " + e.msg);
-  }
-  spec->parse(config, value, where);
+  apply_value(config, *spec, assignment.substr(equals + 1), where, where);
+}
+
+void apply_option(Config& config, const Override& option) {
+  const KeySpec* spec = find_key(option.key);
+  if (spec == nullptr) unknown_key(option.key, option.origin);
+  apply_value(config, *spec, option.value, option.origin + ": " + option.key, option.origin);
 }
 
 Config build(const std::function<void(Config&)>& apply_file,
-             const std::vector<std::string>& overrides) {
+             const std::vector<std::string>& overrides, const std::vector<Override>& options) {
   Config config;
   apply_file(config);
-  for (const auto& assignment : overrides) apply_override(config, assignment);
+  for (const auto& assignment : overrides) apply_assignment(config, assignment);
+  for (const auto& option : options) apply_option(config, option);
   detail::validate_relations(config);
   return config;
 }
@@ -122,21 +140,43 @@ std::vector<std::string> config_keys() {
   return keys;
 }
 
+std::string value_text(const Config& config, const std::string& key) {
+  const KeySpec* spec = find_key(key);
+  if (spec == nullptr) unknown_key(key, "value_text");
+  const auto scalar_text = [](const YAML::Node& node) {
+    double number = 0.0;
+    if (!YAML::convert<double>::decode(node, number) || !std::isfinite(number)) {
+      return node.Scalar();
+    }
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.15g", number);  // 0.064, not 0.064000000000000001
+    return std::string(text);
+  };
+  const YAML::Node value = spec->print(config);
+  if (value.IsNull()) return "null";
+  if (!value.IsSequence()) return scalar_text(value);
+  std::string text = "[";
+  for (size_t i = 0; i < value.size(); ++i) text += (i > 0 ? ", " : "") + scalar_text(value[i]);
+  return text + "]";
+}
+
 Config load_config_text(const std::string& yaml_text, const std::string& origin,
-                        const std::vector<std::string>& overrides) {
+                        const std::vector<std::string>& overrides,
+                        const std::vector<Override>& options) {
   return build(
       [&](Config& config) { apply_document(config, parse_yaml(yaml_text, origin), origin); },
-      overrides);
+      overrides, options);
 }
 
 Config load_config(const std::optional<std::string>& yaml_path,
-                   const std::vector<std::string>& overrides) {
-  if (!yaml_path) return build([](Config&) {}, overrides);
+                   const std::vector<std::string>& overrides,
+                   const std::vector<Override>& options) {
+  if (!yaml_path) return build([](Config&) {}, overrides, options);
   std::ifstream file(*yaml_path, std::ios::binary);
   if (!file) throw ConfigError(*yaml_path + ": cannot open the config file");
   std::ostringstream text;
   text << file.rdbuf();
-  return load_config_text(text.str(), *yaml_path, overrides);
+  return load_config_text(text.str(), *yaml_path, overrides, options);
 }
 
 std::string to_yaml(const Config& config) {

@@ -1,20 +1,13 @@
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
+#include <map>
+#include <set>
 
 #include "featsense/config/config.hpp"
 #include "featsense/config/config_error.hpp"
 
 namespace featsense::config {
 namespace {
-
-std::string read_file(const std::string& path) {
-  std::ifstream file(path);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
 
 const std::string kDefaultYaml = std::string(FEATSENSE_SOURCE_DIR) + "/config/default.yaml";
 
@@ -29,15 +22,17 @@ std::string error_of(F&& f) {
   return "";
 }
 
-TEST(Config, DefaultYamlDocumentsExactlyTheBuiltInDefaults) {
+TEST(Config, DefaultYamlStatesEveryKeyWithItsBuiltInDefault) {
   const Config from_file = load_config(kDefaultYaml);
-  EXPECT_EQ(to_yaml(from_file), to_yaml(Config{}));
-  // Every key of the schema is documented in default.yaml.
-  const std::string text = read_file(kDefaultYaml);
+  const Config defaults;
+  std::set<std::string> stated;
+  for (const auto& [key, where] : from_file.explicit_keys) stated.insert(key);
   for (const std::string& key : config_keys()) {
-    const std::string leaf = key.substr(key.find('.') + 1);
-    EXPECT_NE(text.find("  " + leaf + ":"), std::string::npos) << key;
+    EXPECT_EQ(stated.count(key), 1u) << key << " is not stated in default.yaml";
+    EXPECT_EQ(value_text(from_file, key), value_text(defaults, key)) << key;
   }
+  EXPECT_EQ(stated.size(), config_keys().size());
+  EXPECT_EQ(to_yaml(from_file), to_yaml(defaults));  // every digit, not only the shown ones
 }
 
 TEST(Config, DefaultsAreThoseOfTheDesign) {
@@ -127,6 +122,87 @@ TEST(Config, RelationsBetweenKeysAreChecked) {
             }).find("voxels"),
             std::string::npos);
   EXPECT_NE(error_of([] { load_config({}, {"map.shift_threshold=30"}); }).find("shift_threshold"),
+            std::string::npos);
+}
+
+TEST(Config, KnowsWhichKeysWereSetAndWhere) {
+  EXPECT_TRUE(load_config({}).explicit_keys.empty());
+  EXPECT_TRUE(load_config_text("", "empty.yaml").explicit_keys.empty());
+  EXPECT_TRUE(load_config_text("map:\n", "no_keys.yaml").explicit_keys.empty());
+
+  const Config c = load_config_text("sensor:\n  preset: vlp16\nmap:\n  voxel_size: 0.1\n",
+                                    "my.yaml", {"map.truncation=0.3", "map.voxel_size=0.08"},
+                                    {{"map.backend", "cpu", "--backend cpu"}});
+  EXPECT_EQ(c.explicit_keys,
+            (std::map<std::string, std::string>{{"sensor.preset", "my.yaml:2"},
+                                                {"map.voxel_size", "--set map.voxel_size=0.08"},
+                                                {"map.truncation", "--set map.truncation=0.3"},
+                                                {"map.backend", "--backend cpu"}}));
+  EXPECT_TRUE(c.is_explicit("map.voxel_size"));
+  EXPECT_FALSE(c.is_explicit("map.size"));
+  EXPECT_FALSE(c.is_explicit("odometry.deskew"));
+}
+
+TEST(Config, AKeySetToItsDefaultIsStillSet) {
+  const Config set = load_config({}, {"map.voxel_size=0.064"});
+  EXPECT_DOUBLE_EQ(set.map.voxel_size_m, Config{}.map.voxel_size_m);
+  EXPECT_TRUE(set.is_explicit("map.voxel_size"));
+  EXPECT_FALSE(set.is_explicit("map.truncation"));
+
+  const Config in_file = load_config_text("map: {truncation: 0.25}\n", "f.yaml");
+  EXPECT_TRUE(in_file.is_explicit("map.truncation"));
+  EXPECT_EQ(in_file.explicit_keys.at("map.truncation"), "f.yaml:1");
+
+  const Config by_option = load_config({}, {}, {{"map.backend", "auto", "--backend auto"}});
+  EXPECT_TRUE(by_option.is_explicit("map.backend"));
+  // A null optional key ("the sensor's own") given explicitly is set too.
+  EXPECT_TRUE(load_config({}, {"sensor.max_range=null"}).is_explicit("sensor.max_range"));
+}
+
+TEST(Config, OptionsGoThroughTheSchemaAfterTheSetOnes) {
+  const Config c = load_config(
+      {}, {"map.backend=cuda", "map.voxel_size=0.1"},
+      {{"map.backend", "cpu", "--backend cpu"}, {"map.size", "[20,30,10]", "--map 20x30x10"}});
+  EXPECT_EQ(c.map.backend, Backend::kCpu);
+  EXPECT_DOUBLE_EQ(c.map.voxel_size_m, 0.1);
+  EXPECT_EQ(c.map.size_m, (std::array<double, 3>{20, 30, 10}));
+  EXPECT_EQ(c.explicit_keys.at("map.backend"), "--backend cpu");
+
+  // The one parser's messages, naming the option and the key.
+  const std::string backend = error_of([] {
+    load_config({}, {}, {{"map.backend", "gpu", "--backend gpu"}});
+  });
+  EXPECT_EQ(backend.rfind("--backend gpu: map.backend: unknown value 'gpu'", 0), 0u) << backend;
+  EXPECT_NE(backend.find("choose one of: auto cuda cpu"), std::string::npos) << backend;
+  const std::string voxel = error_of([] {
+    load_config({}, {}, {{"map.voxel_size", "fast", "--voxel fast"}});
+  });
+  EXPECT_EQ(voxel, "--voxel fast: map.voxel_size: expected a number");
+  const std::string range = error_of([] {
+    load_config({}, {}, {{"map.voxel_size", "5", "--voxel 5"}});
+  });
+  EXPECT_NE(range.find("--voxel 5: map.voxel_size: value 5 is out of range"), std::string::npos)
+      << range;
+  const std::string size = error_of([] {
+    load_config({}, {}, {{"map.size", "[40,40]", "--map 40x40"}});
+  });
+  EXPECT_EQ(size, "--map 40x40: map.size: expected a list of 3 numbers");
+  // Relations between keys hold for options too.
+  EXPECT_NE(error_of([] {
+              load_config({}, {}, {{"map.truncation", "0.01", "--truncation 0.01"}});
+            }).find("at least one voxel"),
+            std::string::npos);
+}
+
+TEST(Config, ValueTextIsShort) {
+  const Config c;
+  EXPECT_EQ(value_text(c, "map.voxel_size"), "0.064");
+  EXPECT_EQ(value_text(c, "map.size"), "[40, 40, 15]");
+  EXPECT_EQ(value_text(c, "map.backend"), "auto");
+  EXPECT_EQ(value_text(c, "sensor.min_range"), "null");
+  EXPECT_EQ(value_text(c, "odometry.deskew"), "true");
+  EXPECT_EQ(value_text(c, "odometry.optimization_steps"), "3");
+  EXPECT_NE(error_of([] { value_text(Config{}, "map.voxelsize"); }).find("map.voxel_size"),
             std::string::npos);
 }
 

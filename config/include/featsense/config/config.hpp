@@ -3,6 +3,7 @@
 /// config/default.yaml (a test keeps the two equal). Only config/ parses YAML.
 
 #include <array>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,21 +56,43 @@ struct Config {
   MapConfig map;
   OdometryConfig odometry;
   RefineConfig refine;
+  /// The keys given a value explicitly (by the YAML file, a --set or a command-line option
+  /// that stands for the key), each with where the value that counts came from: "my.yaml:12",
+  /// "--set map.voxel_size=0.05", "--voxel 0.05". A key is here even when the value given
+  /// equals its default; every key not here holds its default.
+  std::map<std::string, std::string> explicit_keys;
+
+  bool is_explicit(const std::string& key) const { return explicit_keys.count(key) != 0; }
+};
+
+/// The value of one key given on the command line by an option that stands for it, e.g.
+/// `--backend cuda` for map.backend. It goes through the same parser and checks as the file
+/// and --set; messages name the option and the key.
+struct Override {
+  std::string key;     ///< "map.backend"
+  std::string value;   ///< the value as YAML: "cuda", "0.05", "[40, 40, 15]"
+  std::string origin;  ///< names the option in messages: "--backend cuda"
 };
 
 std::string to_string(Backend backend);
 
 /// Builds the configuration of a run: the defaults, then the YAML file (if any), then each
-/// `key=value` override in order. Throws ConfigError naming the key and where it came from
-/// for unknown keys (with a did-you-mean), wrong types and out-of-range values.
+/// `key=value` override (--set) in order, then each option override in order. Throws
+/// ConfigError naming the key and where it came from for unknown keys (with a did-you-mean),
+/// wrong types and out-of-range values.
 Config load_config(const std::optional<std::string>& yaml_path,
-                   const std::vector<std::string>& overrides = {});
+                   const std::vector<std::string>& overrides = {},
+                   const std::vector<Override>& options = {});
 /// The same from YAML text instead of a file; `origin` names it in messages.
 Config load_config_text(const std::string& yaml_text, const std::string& origin,
-                        const std::vector<std::string>& overrides = {});
+                        const std::vector<std::string>& overrides = {},
+                        const std::vector<Override>& options = {});
 /// The whole configuration as YAML, every key present, in the layout of default.yaml.
 std::string to_yaml(const Config& config);
 /// Every key path, e.g. "map.voxel_size", in schema order.
 std::vector<std::string> config_keys();
+/// The value of `key` in `config` as short text for help and messages: "0.064", "auto",
+/// "[40, 40, 15]", "null". Throws ConfigError for an unknown key.
+std::string value_text(const Config& config, const std::string& key);
 
 }  // namespace featsense::config
