@@ -54,7 +54,7 @@ TsdfSettings TsdfSettings::from_config(const config::MapConfig& map,
   s.voxel_size_m = static_cast<float>(map.voxel_size_m);
   s.truncation_m = static_cast<float>(map.truncation_m);
   s.max_weight = static_cast<float>(map.max_weight);
-  for (size_t axis = 0; axis < 3; ++axis) s.map_size_m[axis] = static_cast<float>(map.size_m[axis]);
+  s.map_size_m = detail::to_float_size(map.size_m);
   if (map.vertical_interpolation && sensor.beams > 1) {
     s.interpolation_slope =
         static_cast<float>(std::tan(sensor.vertical_fov_rad() / static_cast<double>(sensor.beams)));

@@ -11,11 +11,24 @@
 
 namespace featsense::tsdf {
 
+namespace detail {
+/// The map settings of config/default.yaml, where TsdfSettings' defaults come from.
+inline constexpr config::MapConfig kDefaultMap{};
+
+/// A map size in metres as the floats TsdfSettings keeps.
+constexpr std::array<float, 3> to_float_size(const std::array<double, 3>& size_m) {
+  return {static_cast<float>(size_m[0]), static_cast<float>(size_m[1]),
+          static_cast<float>(size_m[2])};
+}
+}  // namespace detail
+
+/// Default-constructed: the defaults of config::MapConfig (config/default.yaml) as
+/// from_config converts them, without a sensor (no interpolation, every ray carves).
 struct TsdfSettings {
-  float voxel_size_m = 0.064f;
-  float truncation_m = 0.25f;
-  float max_weight = 10.0f;
-  std::array<float, 3> map_size_m = {40.0f, 40.0f, 15.0f};
+  float voxel_size_m = static_cast<float>(detail::kDefaultMap.voxel_size_m);
+  float truncation_m = static_cast<float>(detail::kDefaultMap.truncation_m);
+  float max_weight = static_cast<float>(detail::kDefaultMap.max_weight);
+  std::array<float, 3> map_size_m = detail::to_float_size(detail::kDefaultMap.size_m);
   /// tan of the vertical angle between two beams (vfov / beams, paper eq. 7); 0 = no
   /// vertical interpolation.
   float interpolation_slope = 0.0f;
@@ -34,7 +47,7 @@ struct TsdfSettings {
   /// false: rays walk only the truncation band around their end points (and two voxels in
   /// front of it), free space is not carved. Several times faster, but what moves through
   /// the scene leaves its surfaces in the map.
-  bool carve_free_space = true;
+  bool carve_free_space = detail::kDefaultMap.carve_free_space;
 
   /// Voxels per axis: the size rounded up to whole bricks and to an odd count of bricks, so
   /// that the sensor sits in the centre brick.
