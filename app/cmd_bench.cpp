@@ -25,9 +25,9 @@ namespace featsense::app {
 namespace {
 
 struct BenchTsdfOptions {
-  std::string backend = "auto";
-  std::string map_size = "40x40x15";
-  double voxel_size_m = 0.064;
+  std::optional<std::string> backend;   ///< map.backend
+  std::optional<std::string> map_size;  ///< map.size
+  std::optional<std::string> voxel;     ///< map.voxel_size
   std::string scene = "indoor";
   InputOptions input;
   int scans = 50;
@@ -36,8 +36,11 @@ struct BenchTsdfOptions {
 };
 
 nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext& context) {
-  const std::array<double, 3> size = parse_map_size(options.map_size);
-  const config::Config config = bench_config(context, size, options.voxel_size_m, options.backend);
+  std::vector<config::Override> overrides;
+  add_config_override(overrides, kBackendOption, options.backend);
+  add_config_override(overrides, kMapSizeOption, options.map_size);
+  add_config_override(overrides, kVoxelOption, options.voxel);
+  const config::Config config = context.load_config(overrides);
 
   PreparedScans scans = options.input.input.empty()
                             ? prepare_builtin(options.scene, options.scans)
@@ -100,9 +103,9 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
       {"backend", integrator->backend_name()},
       {"backend_reason", why},
       {"scans", scans.description},
-      {"map_size_m", size},
+      {"map_size_m", config.map.size_m},
       {"map_voxels", {dim.x, dim.y, dim.z}},
-      {"voxel_size_m", options.voxel_size_m},
+      {"voxel_size_m", config.map.voxel_size_m},
       {"truncation_m", settings.truncation_m},
       {"interpolation_slope", settings.interpolation_slope},
       {"timed_scans", t.count},
@@ -122,20 +125,28 @@ nlohmann::json run_bench_tsdf(const BenchTsdfOptions& options, const CliContext&
   return result;
 }
 
+/// bench mesh's --map: the hall's size.
+constexpr ConfigOption kHallSizeOption{"--map", "map.size", "XxYxZ", "Hall size, metres", 'x'};
+
 struct BenchMeshOptions {
-  std::string map_size = "40x40x15";
-  double voxel_size_m = 0.064;
-  double truncation_m = 0.25;
+  std::optional<std::string> map_size;    ///< map.size
+  std::optional<std::string> voxel;       ///< map.voxel_size
+  std::optional<std::string> truncation;  ///< map.truncation
   int repeat = 7;
   int threads = 0;
   std::optional<std::string> json_path;
 };
 
-nlohmann::json run_bench_mesh(const BenchMeshOptions& options) {
-  const std::array<double, 3> size = parse_map_size(options.map_size);
+nlohmann::json run_bench_mesh(const BenchMeshOptions& options, const CliContext& context) {
+  std::vector<config::Override> overrides;
+  add_config_override(overrides, kHallSizeOption, options.map_size);
+  add_config_override(overrides, kVoxelOption, options.voxel);
+  add_config_override(overrides, kTruncationOption, options.truncation);
+  const config::MapConfig map = context.load_config(overrides).map;
   const auto build_start = std::chrono::steady_clock::now();
-  storage::MemoryChunkStore store = make_room_map(Eigen::Vector3d(size[0], size[1], size[2]),
-                                                  options.voxel_size_m, options.truncation_m);
+  storage::MemoryChunkStore store =
+      make_room_map(Eigen::Vector3d(map.size_m[0], map.size_m[1], map.size_m[2]), map.voxel_size_m,
+                    map.truncation_m);
   const double build_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
   mesh::MeshingSettings settings;
@@ -158,9 +169,9 @@ nlohmann::json run_bench_mesh(const BenchMeshOptions& options) {
   return {
       {"benchmark", "mesh"},
       {"map", "synthetic furnished hall (exact TSDF, free space observed)"},
-      {"map_size_m", size},
-      {"voxel_size_m", options.voxel_size_m},
-      {"truncation_m", options.truncation_m},
+      {"map_size_m", map.size_m},
+      {"voxel_size_m", map.voxel_size_m},
+      {"truncation_m", map.truncation_m},
       {"map_build_s", build_s},
       {"threads", threads},
       {"runs", t.count},
@@ -182,17 +193,13 @@ void print_result(const nlohmann::json& result, const std::optional<std::string>
   std::cout << result.dump(2) << "\n";
 }
 
-Command register_bench_mesh(CLI::App& bench) {
+Command register_bench_mesh(CLI::App& bench, const CliContext& context) {
   auto options = std::make_shared<BenchMeshOptions>();
   CLI::App* mesh = bench.add_subcommand(
       "mesh", "Marching cubes over a furnished hall: ms per run, voxels/s, triangles/s");
-  mesh->add_option("--map", options->map_size, "Hall size XxYxZ, metres")->capture_default_str();
-  mesh->add_option("--voxel", options->voxel_size_m, "Voxel size, metres")
-      ->check(CLI::Range(0.01, 1.0))
-      ->capture_default_str();
-  mesh->add_option("--truncation", options->truncation_m, "Tau, metres")
-      ->check(CLI::Range(0.01, 10.0))
-      ->capture_default_str();
+  add_config_option(*mesh, kHallSizeOption, options->map_size);
+  add_config_option(*mesh, kVoxelOption, options->voxel);
+  add_config_option(*mesh, kTruncationOption, options->truncation);
   mesh->add_option("--repeat", options->repeat, "Timed runs")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
@@ -200,7 +207,9 @@ Command register_bench_mesh(CLI::App& bench) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   mesh->add_option("--json", options->json_path, "Write the JSON here too ('-' = stdout only)");
-  return {mesh, [options] { print_result(run_bench_mesh(*options), options->json_path); }};
+  return {mesh, [options, &context] {
+            print_result(run_bench_mesh(*options, context), options->json_path);
+          }};
 }
 
 }  // namespace
@@ -211,12 +220,9 @@ std::vector<Command> register_bench(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<BenchTsdfOptions>();
   CLI::App* tsdf = bench->add_subcommand(
       "tsdf", "Integrate OS1-128 scans into the TSDF local map: per-scan ms, points/s, memory");
-  tsdf->add_option("--backend", options->backend, "auto, cuda or cpu")
-      ->check(CLI::IsMember({"auto", "cuda", "cpu"}))
-      ->capture_default_str();
-  tsdf->add_option("--map", options->map_size, "Local map size XxYxZ, metres")
-      ->capture_default_str();
-  tsdf->add_option("--voxel", options->voxel_size_m, "Voxel size, metres")->capture_default_str();
+  add_config_option(*tsdf, kBackendOption, options->backend);
+  add_config_option(*tsdf, kMapSizeOption, options->map_size);
+  add_config_option(*tsdf, kVoxelOption, options->voxel);
   tsdf->add_option("--scene", options->scene,
                    "Built-in scans: indoor (20 x 20 x 4 m room) or outdoor")
       ->check(CLI::IsMember({"indoor", "outdoor"}))
@@ -236,7 +242,7 @@ std::vector<Command> register_bench(CLI::App& app, const CliContext& context) {
   const Command tsdf_command{tsdf, [options, &context] {
                                print_result(run_bench_tsdf(*options, context), options->json_path);
                              }};
-  return {tsdf_command, register_bench_mesh(*bench)};
+  return {tsdf_command, register_bench_mesh(*bench, context)};
 }
 
 }  // namespace featsense::app

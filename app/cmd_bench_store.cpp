@@ -23,9 +23,9 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 struct BenchStoreOptions {
-  std::string backend = "auto";
-  std::string map_size = "40x40x15";
-  double voxel_size_m = 0.064;
+  std::optional<std::string> backend;   ///< map.backend
+  std::optional<std::string> map_size;  ///< map.size
+  std::optional<std::string> voxel;     ///< map.voxel_size
   double shift_m = 10.0;
   int scans = 4;
   int repeat = 6;
@@ -38,8 +38,11 @@ double seconds_since(Clock::time_point start) {
 }
 
 nlohmann::json run_bench_store(const BenchStoreOptions& options, const CliContext& context) {
-  const std::array<double, 3> size = parse_map_size(options.map_size);
-  const config::Config config = bench_config(context, size, options.voxel_size_m, options.backend);
+  std::vector<config::Override> overrides;
+  add_config_override(overrides, kBackendOption, options.backend);
+  add_config_override(overrides, kMapSizeOption, options.map_size);
+  add_config_override(overrides, kVoxelOption, options.voxel);
+  const config::Config config = context.load_config(overrides);
   const PreparedScans scans = prepare_builtin("outdoor", options.scans);
   const tsdf::TsdfSettings settings = tsdf::TsdfSettings::from_config(config.map, scans.sensor);
   std::string why;
@@ -93,8 +96,8 @@ nlohmann::json run_bench_store(const BenchStoreOptions& options, const CliContex
       {"benchmark", "store"},
       {"backend", integrator->backend_name()},
       {"backend_reason", why},
-      {"map_size_m", size},
-      {"voxel_size_m", options.voxel_size_m},
+      {"map_size_m", config.map.size_m},
+      {"voxel_size_m", config.map.voxel_size_m},
       {"shift_m", shift_voxels * config.map.voxel_size_m},
       {"timed_shifts", t.count},
       {"median_ms", t.median_ms},
@@ -121,13 +124,9 @@ Command register_bench_store(CLI::App& bench, const CliContext& context) {
   auto options = std::make_shared<BenchStoreOptions>();
   CLI::App* command = bench.add_subcommand(
       "store", "Move a full local map through the HDF5 store: ms per shift (spill + load)");
-  command->add_option("--backend", options->backend, "auto, cuda or cpu")
-      ->check(CLI::IsMember({"auto", "cuda", "cpu"}))
-      ->capture_default_str();
-  command->add_option("--map", options->map_size, "Local map size XxYxZ, metres")
-      ->capture_default_str();
-  command->add_option("--voxel", options->voxel_size_m, "Voxel size, metres")
-      ->capture_default_str();
+  add_config_option(*command, kBackendOption, options->backend);
+  add_config_option(*command, kMapSizeOption, options->map_size);
+  add_config_option(*command, kVoxelOption, options->voxel);
   command->add_option("--shift", options->shift_m, "Distance of each move, metres")
       ->check(CLI::Range(0.5, 1000.0))
       ->capture_default_str();

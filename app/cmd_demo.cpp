@@ -100,8 +100,7 @@ Command register_demo(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   command->add_option("--frames", options->frames, "Frames to simulate (default: the whole path)")
       ->check(CLI::Range(1, 100000));
-  command->add_option("--backend", options->backend, "TSDF backend: auto, cuda or cpu")
-      ->check(CLI::IsMember({"auto", "cuda", "cpu"}));
+  add_config_option(*command, kBackendOption, options->backend);
   return {command, [options, &context] { run_demo(*options, context); }};
 }
 

@@ -93,13 +93,9 @@ tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
 }  // namespace
 
 config::Config map_config(const MapOptions& options, const CliContext& context) {
-  config::Config config = context.load_config();
-  if (options.backend) {
-    config.map.backend = *options.backend == "cuda"  ? config::Backend::kCuda
-                         : *options.backend == "cpu" ? config::Backend::kCpu
-                                                     : config::Backend::kAuto;
-  }
-  return config;
+  std::vector<config::Override> overrides;
+  add_config_override(overrides, kBackendOption, options.backend);
+  return context.load_config(overrides);
 }
 
 MapOutcome run_map(const MapOptions& options, const CliContext& context) {
@@ -237,9 +233,7 @@ Command register_map(CLI::App& app, const CliContext& context) {
       ->check(CLI::IsMember({"auto", "tum", "kitti"}));
   command->add_option("--gt-times", options->gt_times, "Times file of KITTI poses (times.txt)")
       ->check(CLI::ExistingFile);
-  command
-      ->add_option("--backend", options->backend, "TSDF backend (map.backend): auto, cuda or cpu")
-      ->check(CLI::IsMember({"auto", "cuda", "cpu"}));
+  add_config_option(*command, kBackendOption, options->backend);
   command->add_option("--continue", options->continue_from,
                       "Continue an existing map (.h5 or .vdb): its voxel size and tau are kept");
   command->add_option("--start", options->start,

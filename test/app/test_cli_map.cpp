@@ -176,6 +176,14 @@ TEST_F(CliMap, BadInputGivesOneClearError) {
   EXPECT_NE(r.output.find("no scan was mapped: skipped: no pose for scan 0"), std::string::npos)
       << r.output;
 
+  // --backend goes through the config's schema: its message names the option and the key.
+  r = run_featsense("map " + sequence() + " -o " + (dir / "gpu").string() + " --gt " + gt() +
+                    kSmallMap + " --backend gpu");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("config: --backend gpu: map.backend: unknown value 'gpu'"),
+            std::string::npos)
+      << r.output;
+
   r = run_featsense("map " + sequence() + " -o " + (dir / "range").string() + " --gt " + gt() +
                     kSmallMap + " --start ten");
   EXPECT_EQ(r.exit_code, 2);
