@@ -235,7 +235,8 @@ Command register_map(CLI::App& app, const CliContext& context) {
       ->check(CLI::ExistingFile);
   add_config_option(*command, kBackendOption, options->backend);
   command->add_option("--continue", options->continue_from,
-                      "Continue an existing map (.h5 or .vdb): its voxel size and tau are kept");
+                      "Continue an existing map (.h5 or .vdb): its voxel size and tau are kept "
+                      "(map.voxel_size and map.truncation, if set, must be the same)");
   command->add_option("--start", options->start,
                       "First scan to map: a frame index, or seconds after the first scan (12.5s)");
   command->add_option("--end", options->end, "Last scan to map (as --start)");

@@ -1,5 +1,8 @@
 #include "map_store.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <charconv>
 #include <cmath>
 
 #include "featsense/config/config_error.hpp"
@@ -20,22 +23,36 @@ storage::MapMetadata metadata_of(const config::Config& config, const std::string
   return m;
 }
 
-bool same(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
+/// The map is built in floats (TsdfSettings), and a .vdb holds its voxel size and tau as
+/// floats: values that are the same float are the same.
+bool same(double a, double b) { return static_cast<float>(a) == static_cast<float>(b); }
 
-/// The old map's voxel size and tau win; values asked for explicitly must agree with them.
+/// A length as short text: the float the map uses, in as few digits as tell it apart.
+std::string metres(double value) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof(text), static_cast<float>(value)).ptr;
+  return std::string(text, end);
+}
+
+/// The old map's voxel size and tau win over values that were not set; a value set
+/// explicitly (config file, --set or an option), even to the default, must be the old map's.
 void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
                         config::Config& config) {
-  const config::MapConfig defaults;
-  const auto adopt = [&](const char* key, double& value, double default_value, double old_value) {
-    if (!same(value, default_value) && !same(value, old_value)) {
-      throw config::ConfigError(std::string(key) + " = " + std::to_string(value) +
-                                " differs from the continued map's " + std::to_string(old_value) +
-                                " (" + what + "); a map keeps its voxel size and tau");
+  const auto adopt = [&](const std::string& key, double& value, double old_value) {
+    const auto given = config.explicit_keys.find(key);
+    if (given != config.explicit_keys.end() && !same(value, old_value)) {
+      throw config::ConfigError(key + " = " + metres(value) + " (" + given->second +
+                                ") differs from the continued map's " + metres(old_value) + " (" +
+                                what + "); a map keeps its voxel size and tau: leave " + key +
+                                " unset to continue it");
+    }
+    if (!same(value, old_value)) {
+      spdlog::info("{} = {} of the continued map {}", key, metres(old_value), what);
     }
     value = old_value;
   };
-  adopt("map.voxel_size", config.map.voxel_size_m, defaults.voxel_size_m, old_map.voxel_size_m);
-  adopt("map.truncation", config.map.truncation_m, defaults.truncation_m, old_map.truncation_m);
+  adopt("map.voxel_size", config.map.voxel_size_m, old_map.voxel_size_m);
+  adopt("map.truncation", config.map.truncation_m, old_map.truncation_m);
 }
 
 slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses) {

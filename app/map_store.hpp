@@ -22,8 +22,8 @@ struct MapStore {
 /// Creates `path` for a map of `config` (an existing file is an error unless `overwrite`),
 /// or, with `continue_from`, a copy of that map at `path` (in place when it is `path`).
 /// With `continue_from`, config.map.voxel_size and map.truncation are set to the old map's;
-/// a configuration that asked for other values explicitly (not the defaults) is a
-/// ConfigError naming both.
+/// a configuration that set either explicitly (config.explicit_keys) to another value, the
+/// default included, is a ConfigError naming both.
 MapStore open_map_store(const std::filesystem::path& path, config::Config& config,
                         const std::string& sensor_name,
                         const std::optional<std::string>& continue_from, bool overwrite);

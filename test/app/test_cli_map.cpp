@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -134,6 +135,64 @@ TEST_F(CliMap, ContinuingFromAVdbKeepsItsVoxelSize) {
   storage::Hdf5ChunkStore store(dir / "second" / "map.h5");
   EXPECT_NEAR(store.metadata().voxel_size_m, 0.1, 1e-9);
   EXPECT_NEAR(store.metadata().truncation_m, 0.3, 1e-6);
+}
+
+TEST_F(CliMap, ContinuingRejectsAGeometrySetExplicitlyEvenToTheDefault) {
+  const fs::path dir = scratch_dir("cli_map_continue_explicit");
+  // A map at 5 cm voxels and 0.2 m tau, neither the default (0.064 m, 0.25 m).
+  const std::string geometry = " --set map.size=[8,8,4] --set map.shift_threshold=1.0";
+  const std::string first = (dir / "first" / "map.h5").string();
+  const CommandResult mapped =
+      run_featsense("map " + sequence() + " -o " + (dir / "first").string() + " --end 3 --gt " +
+                    gt() + " --quiet --backend cpu --no-mesh" + geometry +
+                    " --set map.voxel_size=0.05 --set map.truncation=0.2");
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.output;
+  const std::string continued = "map " + sequence() + " --start 4 --end 5 --gt " + gt() +
+                                " --quiet --backend cpu --no-mesh" + geometry + " --continue " +
+                                first + " -o ";
+
+  CommandResult r =
+      run_featsense(continued + (dir / "voxel").string() + " --set map.voxel_size=0.064");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("map.voxel_size = 0.064 (--set map.voxel_size=0.064) differs from the "
+                          "continued map's 0.05 (" +
+                          first + ")"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+
+  r = run_featsense(continued + (dir / "tau").string() + " --set map.truncation=0.25");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("map.truncation = 0.25 (--set map.truncation=0.25) differs from the "
+                          "continued map's 0.2"),
+            std::string::npos)
+      << r.output;
+
+  // A config file that states the default counts as setting it too, and is named.
+  const fs::path yaml = dir / "defaults.yaml";
+  std::ofstream(yaml) << "map:\n  voxel_size: 0.064\n";
+  r = run_featsense(continued + (dir / "file").string() + " --config " + yaml.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("map.voxel_size = 0.064 (" + yaml.string() + ":2) differs"),
+            std::string::npos)
+      << r.output;
+  for (const char* name : {"voxel", "tau", "file"}) {
+    EXPECT_FALSE(fs::exists(dir / name / "map.h5")) << name;
+  }
+
+  // Neither key set: the continued map's voxel size and tau are adopted, and said so.
+  r = run_featsense("map " + sequence() + " --start 4 --end 5 --gt " + gt() +
+                    " --backend cpu --no-mesh" + geometry + " --continue " + first + " -o " +
+                    (dir / "adopted").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("map.voxel_size = 0.05 of the continued map " + first), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("map.truncation = 0.2 of the continued map " + first), std::string::npos)
+      << r.output;
+  storage::Hdf5ChunkStore store(dir / "adopted" / "map.h5");
+  EXPECT_NEAR(store.metadata().voxel_size_m, 0.05, 1e-12);
+  EXPECT_NEAR(store.metadata().truncation_m, 0.2, 1e-12);
+  EXPECT_EQ(store.read_trajectory().size(), 6u) << "the old poses and the new";
 }
 
 TEST_F(CliMap, BadInputGivesOneClearError) {
