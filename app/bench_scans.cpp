@@ -47,8 +47,17 @@ PreparedScans prepare_builtin(const std::string& scene, int count) {
   int frame = 0;
   while (auto scan = source->next()) {
     const double frame_start = frame / settings.sensor.rate_hz;
-    prepared.rays.push_back(deskewed_scan_to_rays(
-        *scan, [&](double t) { return slam::box_room_pose(settings, frame_start + t); }));
+    slam::ScanPlacement placement;
+    placement.T_map_sensor = slam::box_room_pose(settings, frame_start);
+    placement.column_T_map_sensor.assign(static_cast<size_t>(scan->cols), placement.T_map_sensor);
+    const std::vector<std::optional<float>> times = scan->column_time_offsets_s();
+    for (size_t col = 0; col < times.size(); ++col) {
+      if (times[col]) {
+        placement.column_T_map_sensor[col] =
+            slam::box_room_pose(settings, frame_start + static_cast<double>(*times[col]));
+      }
+    }
+    prepared.rays.push_back(scan_to_rays(*scan, placement));
     prepared.input_points += prepared.rays.back().size();
     ++frame;
   }
@@ -64,7 +73,7 @@ PreparedScans prepare_recording(const InputOptions& input, const config::Config&
   while (static_cast<int>(prepared.rays.size()) < count) {
     std::optional<slam::Scan> scan = source->next();
     if (!scan) break;
-    prepared.rays.push_back(scan_to_rays(*scan, Eigen::Isometry3d::Identity()));
+    prepared.rays.push_back(scan_to_rays(*scan, slam::ScanPlacement{}));
     prepared.input_points += prepared.rays.back().size();
   }
   if (prepared.rays.empty()) throw slam::InputError(input.input + ": no readable frame");

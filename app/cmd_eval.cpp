@@ -20,7 +20,7 @@ namespace {
 struct EvalTrajOptions {
   std::string estimate;
   std::string ground_truth;
-  std::string format = "tum";
+  std::string format = "auto";
   std::string align = "se3";
   double max_diff_s = 0.01;
   double offset_s = 0.0;
@@ -47,10 +47,10 @@ void emit(const nlohmann::json& json, const std::optional<std::string>& path,
 
 slam::Trajectory read_trajectory(const std::string& path, const std::string& format,
                                  const std::optional<std::string>& times) {
-  if (times && format != "kitti") {
-    throw config::ConfigError("--est-times / --gt-times go with --format kitti");
+  if (times && format == "tum") {
+    throw config::ConfigError("--est-times / --gt-times go with KITTI poses, not --format tum");
   }
-  return format == "kitti" ? slam::read_kitti(path, times) : slam::read_tum(path);
+  return slam::read_trajectory(path, format, times);
 }
 
 void run_traj(const EvalTrajOptions& options) {
@@ -165,8 +165,9 @@ std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/)
   traj->add_option("EST", traj_options->estimate, "Estimated trajectory")->required();
   traj->add_option("GT", traj_options->ground_truth, "Ground-truth trajectory")->required();
   traj->add_option("--format", traj_options->format,
-                   "File format of both: tum, or kitti (no stamps: paired by index)")
-      ->check(CLI::IsMember({"tum", "kitti"}))
+                   "File format of each: auto (from the content), tum, or kitti (no stamps: "
+                   "paired by index)")
+      ->check(CLI::IsMember({"auto", "tum", "kitti"}))
       ->capture_default_str();
   traj->add_option("--align", traj_options->align, "Umeyama alignment: se3, se3-scale or none")
       ->check(CLI::IsMember({"se3", "se3-scale", "none"}))

@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
+#include "featsense/slam/trajectory/given_pose_locator.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "json_output.hpp"
@@ -27,25 +28,6 @@ namespace featsense::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// "tum" when the first data line has 8 numbers, "kitti" for 12.
-std::string detect_trajectory_format(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw slam::TrajectoryError("cannot open trajectory " + path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    size_t count = 0;
-    for (std::string field; fields >> field;) ++count;
-    if (count == 0) continue;
-    if (count == 8) return "tum";
-    if (count == 12) return "kitti";
-    throw slam::TrajectoryError(path + ": a line of " + std::to_string(count) +
-                                " numbers is neither TUM (8) nor KITTI (12); see --gt-format");
-  }
-  throw slam::TrajectoryError(path + " holds no pose");
-}
 
 /// --start / --end: a frame index ("120") or seconds after the first scan ("12.5s").
 void parse_range_end(const std::string& text, const char* option, std::optional<uint64_t>& frame,
@@ -76,13 +58,10 @@ FrameRange frame_range(const MapOptions& options) {
 }
 
 slam::Trajectory read_poses(const MapOptions& options) {
-  const std::string format =
-      options.gt_format == "auto" ? detect_trajectory_format(*options.gt) : options.gt_format;
-  if (options.gt_times && format != "kitti") {
-    throw config::ConfigError("--gt-times goes with KITTI poses");
+  if (options.gt_times && options.gt_format == "tum") {
+    throw config::ConfigError("--gt-times goes with KITTI poses, not --gt-format tum");
   }
-  return format == "kitti" ? slam::read_kitti(*options.gt, options.gt_times)
-                           : slam::read_tum(*options.gt);
+  return slam::read_trajectory(*options.gt, options.gt_format, options.gt_times);
 }
 
 tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
@@ -116,8 +95,8 @@ MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
                          const MeshReferences& references, const CliContext& context) {
   const FrameRange range = frame_range(options);
   const slam::SourceInfo& info = source.info();
-  std::unique_ptr<ScanLocator> locator =
-      make_given_pose_locator(std::move(poses), config.odometry.deskew);
+  std::unique_ptr<slam::ScanLocator> locator =
+      slam::make_given_pose_locator(std::move(poses), config.odometry.deskew);
 
   const fs::path out(options.output);
   fs::create_directories(out);
@@ -131,7 +110,7 @@ MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
   std::string backend_reason;
   const MapOpener open_map = [&](const LocatedScan& first) -> storage::ShiftingMap& {
     integrator = tsdf::make_integrator(config.map.backend, settings,
-                                       position_of(first.T_map_sensor), &backend_reason);
+                                       position_of(first.placement.T_map_sensor), &backend_reason);
     spdlog::info("TSDF: {}", backend_reason);
     map = std::make_unique<storage::ShiftingMap>(*integrator, store, config.map.shift_threshold_m);
     return *map;

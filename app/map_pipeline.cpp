@@ -12,6 +12,7 @@
 #include "bounded_queue.hpp"
 #include "featsense/slam/preprocess/mixed_pixel_filter.hpp"
 #include "progress.hpp"
+#include "scan_to_rays.hpp"
 #include "stop_signal.hpp"
 
 namespace featsense::app {
@@ -82,20 +83,23 @@ void read_scans(slam::ScanSource& source, const FrameRange& range, BoundedQueue<
   }
 }
 
-void locate_scans(ScanLocator& locator, bool drop_mixed, BoundedQueue<slam::Scan>& in,
+void locate_scans(slam::ScanLocator& locator, bool drop_mixed, BoundedQueue<slam::Scan>& in,
                   BoundedQueue<LocatedScan>& out, PipelineState& state, PipelineResult& result) {
   while (std::optional<slam::Scan> scan = in.pop()) {
     const Clock::time_point start = Clock::now();
     if (drop_mixed) result.mixed_pixels_dropped += slam::drop_mixed_pixels(*scan);
     std::string why;
-    std::optional<LocatedScan> located = locator.locate(*scan, why);
-    if (!located) {
+    std::optional<slam::ScanPlacement> placement = locator.locate(*scan, why);
+    if (!placement) {
       ++result.frames_without_pose;
       state.warn("skipped: " + why, result);
       continue;
     }
+    LocatedScan located;
+    located.rays = scan_to_rays(*scan, *placement);
+    located.placement = std::move(*placement);
     result.timings.locate_ms.push_back(ms_since(start));
-    if (!out.push(std::move(*located))) break;
+    if (!out.push(std::move(located))) break;
   }
 }
 
@@ -109,7 +113,7 @@ class MappingStage {
     Clock::time_point last_flush = Clock::now();
     while (std::optional<LocatedScan> scan = in.pop()) {
       if (!map_) map_ = &open_map_(*scan);
-      const Eigen::Vector3d at = scan->T_map_sensor.translation();
+      const Eigen::Vector3d at = scan->placement.T_map_sensor.translation();
       Clock::time_point start = Clock::now();
       map_->follow(
           {static_cast<float>(at.x()), static_cast<float>(at.y()), static_cast<float>(at.z())});
@@ -120,7 +124,7 @@ class MappingStage {
       result_.timings.integrate_ms.push_back(ms_since(start));
       result_.points += scan->rays.size();
       result_.voxels_updated += stats.voxels_updated;
-      result_.poses.push_back(scan->stamp_ns, scan->T_map_sensor);
+      result_.poses.push_back(scan->placement.stamp_ns, scan->placement.T_map_sensor);
       ++result_.frames_mapped;
 
       if (std::chrono::duration<double>(Clock::now() - last_flush).count() >=
@@ -161,7 +165,7 @@ void guarded(PipelineState& state, const Work& work) {
 
 }  // namespace
 
-PipelineResult run_map_pipeline(slam::ScanSource& source, ScanLocator& locator,
+PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& locator,
                                 const MapOpener& open_map, const PipelineSettings& settings) {
   PipelineResult result;
   PipelineState state;

@@ -10,10 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/shifting_map.hpp"
-#include "scan_locator.hpp"
+#include "featsense/tsdf/ray_batch.hpp"
 
 namespace featsense::app {
 
@@ -24,6 +25,13 @@ struct FrameRange {
   std::optional<uint64_t> last_frame;
   std::optional<double> first_s;
   std::optional<double> last_s;
+};
+
+/// A scan placed by the front end and turned into rays (app/scan_to_rays.hpp): what the
+/// mapping thread integrates.
+struct LocatedScan {
+  slam::ScanPlacement placement;
+  tsdf::RayBatch rays;
 };
 
 struct PipelineSettings {
@@ -67,7 +75,7 @@ using MapOpener = std::function<storage::ShiftingMap&(const LocatedScan& first)>
 
 /// Runs the pipeline until the source ends, the range ends or a stop signal arrives. The
 /// caller syncs the map afterwards (also when this throws: what was integrated is in the map).
-PipelineResult run_map_pipeline(slam::ScanSource& source, ScanLocator& locator,
+PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& locator,
                                 const MapOpener& open_map, const PipelineSettings& settings);
 
 }  // namespace featsense::app

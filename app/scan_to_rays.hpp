@@ -1,24 +1,16 @@
 #pragma once
-// A scan as TSDF rays in the map frame: each point moved by the sensor pose at its own time
-// (deskewing) and its ray starting where the sensor was then.
-
-#include <Eigen/Geometry>
-
-#include <functional>
+// A placed scan as TSDF rays in the map frame: each point moved by the sensor's pose when
+// its column was measured (deskewing, where the placement carries the motion over the scan)
+// and its ray starting where the sensor was then. Which rays interpolate and which carve
+// near the sensor are the TSDF's rules (tsdf/scan_rays.hpp).
 
 #include "featsense/slam/scan.hpp"
+#include "featsense/slam/scan_locator.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
 
 namespace featsense::app {
 
-/// The pose map <- sensor at `seconds_after_stamp` after the scan's stamp.
-using PoseAt = std::function<Eigen::Isometry3d(double seconds_after_stamp)>;
-
-/// Every valid point of `scan` in the map frame with the sensor pose at the scan's stamp.
-tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const Eigen::Isometry3d& T_map_sensor);
-
-/// The same with per-column poses: `pose_at` is asked once per column (time grows with the
-/// column), each point is moved by its own column's pose and its ray starts there.
-tsdf::RayBatch deskewed_scan_to_rays(const slam::Scan& scan, const PoseAt& pose_at);
+/// Every valid point of `scan` as a ray in the map frame, row by row.
+tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const slam::ScanPlacement& placement);
 
 }  // namespace featsense::app

@@ -1,6 +1,7 @@
 #include "source_options.hpp"
 
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/sim/box_room_source.hpp"
 
 namespace featsense::app {

@@ -29,7 +29,7 @@ slam::Scan column_scan(int rows, Surface surface) {
 
 TEST(ScanToRays, AWallFacingTheSensorInterpolates) {
   const slam::Scan wall = column_scan(16, [](const Eigen::Vector3d& d) { return 10.0 / d.x(); });
-  const tsdf::RayBatch rays = scan_to_rays(wall, Eigen::Isometry3d::Identity());
+  const tsdf::RayBatch rays = scan_to_rays(wall, slam::ScanPlacement{});
   ASSERT_EQ(rays.interpolate.size(), 16u);
   for (size_t i = 0; i < rays.size(); ++i) EXPECT_TRUE(rays.may_interpolate(i)) << i;
 }
@@ -39,7 +39,7 @@ TEST(ScanToRays, GroundAtAGrazingAngleDoesNot) {
   // farther, far more than the 0.35 deg gap explains for a surface facing the sensor.
   const slam::Scan ground =
       column_scan(32, [](const Eigen::Vector3d& d) { return d.z() < -1e-3 ? -1.8 / d.z() : -1.0; });
-  const tsdf::RayBatch rays = scan_to_rays(ground, Eigen::Isometry3d::Identity());
+  const tsdf::RayBatch rays = scan_to_rays(ground, slam::ScanPlacement{});
   ASSERT_GT(rays.size(), 10u);
   for (size_t i = 0; i < rays.size(); ++i) EXPECT_FALSE(rays.may_interpolate(i)) << i;
 }
@@ -52,7 +52,7 @@ TEST(ScanToRays, DepthEdgesDoNotInterpolateAcrossTheGap) {
     edge.xyz[i] *= 12.0f / 5.0f;
     edge.range_m[i] *= 12.0f / 5.0f;
   }
-  const tsdf::RayBatch rays = scan_to_rays(edge, Eigen::Isometry3d::Identity());
+  const tsdf::RayBatch rays = scan_to_rays(edge, slam::ScanPlacement{});
   for (size_t i = 0; i < rays.size(); ++i) {
     EXPECT_EQ(rays.may_interpolate(i), i != 7 && i != 8) << i;
   }
@@ -79,10 +79,11 @@ TEST(ScanToRays, CarvingLevelsFormALatticeOfBeamsAndColumns) {
     while (row % (2 << level) == 0 && col % (2 << level) == 0) ++level;
     return level;
   };
-  const tsdf::RayBatch rays = scan_to_rays(scan, Eigen::Isometry3d::Identity());
+  const tsdf::RayBatch rays = scan_to_rays(scan, slam::ScanPlacement{});
   ASSERT_EQ(rays.carving_level.size(), 63u);
-  const tsdf::RayBatch deskewed =
-      deskewed_scan_to_rays(scan, [](double) { return Eigen::Isometry3d::Identity(); });
+  slam::ScanPlacement moving;
+  moving.column_T_map_sensor.assign(8, Eigen::Isometry3d::Identity());
+  const tsdf::RayBatch deskewed = scan_to_rays(scan, moving);
   ASSERT_EQ(deskewed.carving_level.size(), 63u);
   size_t k = 0;
   for (int row = 0; row < 8; ++row) {  // both come row by row
@@ -98,33 +99,31 @@ TEST(ScanToRays, CarvingLevelsFormALatticeOfBeamsAndColumns) {
 }
 
 TEST(ScanToRays, DeskewedRaysStartWhereTheSensorWasWhenTheirColumnFired) {
-  // 4 beams x 6 columns, column c fired at 0.1 c s while the sensor moved 1 m/s along x;
-  // column 3 has no valid point. Each ray starts at its column's position and its end point
-  // moved with it, row by row; the pose is asked for once per column with a point.
+  // 4 beams x 6 columns, the sensor at x = 0.1 c m when column c fired; column 3 has no valid
+  // point. Each ray starts at its column's position and its end point moved with it, row by
+  // row; the sensor's up axis is the one at the stamp.
   slam::Scan scan = slam::Scan::allocate(4, 6);
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 6; ++col) {
       const size_t i = scan.index(row, col);
-      scan.time_offset_s[i] = 0.1f * static_cast<float>(col);
       if (col == 3 || (row == 0 && col == 1)) continue;
       scan.valid[i] = 1;
       scan.xyz[i] = Eigen::Vector3f(4.0f, static_cast<float>(col), static_cast<float>(row));
       scan.range_m[i] = scan.xyz[i].norm();
     }
   }
-  int poses_asked = 0;
-  const tsdf::RayBatch rays = deskewed_scan_to_rays(scan, [&](double seconds) {
-    ++poses_asked;
-    return Eigen::Isometry3d(Eigen::Translation3d(seconds, 0.0, 0.0));
-  });
-  EXPECT_EQ(poses_asked, 1 + 5);  // the sensor's up axis at the stamp, then each column
+  slam::ScanPlacement placement;
+  for (int col = 0; col < 6; ++col) {
+    placement.column_T_map_sensor.emplace_back(Eigen::Translation3d(0.1 * col, 0.0, 0.0));
+  }
+  const tsdf::RayBatch rays = scan_to_rays(scan, placement);
   ASSERT_EQ(rays.size(), 19u);
   ASSERT_EQ(rays.origins_m.size(), 19u);
   size_t k = 0;
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 6; ++col) {
       if (col == 3 || (row == 0 && col == 1)) continue;
-      const float x = 0.1f * static_cast<float>(col);
+      const float x = static_cast<float>(0.1 * col);
       EXPECT_FLOAT_EQ(rays.origins_m[k].x, x) << row << ", " << col;
       EXPECT_FLOAT_EQ(rays.endpoints_m[k].x, 4.0f + x) << row << ", " << col;
       EXPECT_FLOAT_EQ(rays.endpoints_m[k].y, static_cast<float>(col));
@@ -132,6 +131,15 @@ TEST(ScanToRays, DeskewedRaysStartWhereTheSensorWasWhenTheirColumnFired) {
       ++k;
     }
   }
+}
+
+TEST(ScanToRays, APlacementWithTheWrongNumberOfColumnPosesIsRefused) {
+  slam::Scan scan = slam::Scan::allocate(2, 4);
+  scan.valid[0] = 1;
+  scan.xyz[0] = Eigen::Vector3f(1.0f, 0.0f, 0.0f);
+  slam::ScanPlacement placement;
+  placement.column_T_map_sensor.assign(3, Eigen::Isometry3d::Identity());
+  EXPECT_THROW(scan_to_rays(scan, placement), std::invalid_argument);
 }
 
 }  // namespace

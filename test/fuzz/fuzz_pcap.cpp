@@ -15,7 +15,7 @@
 
 #include "featsense/slam/io/ouster_frame_assembler.hpp"
 #include "featsense/slam/scan_source.hpp"
-#include "io/ouster/pcap_udp_reader.hpp"
+#include "ouster/pcap_udp_reader.hpp"
 
 namespace {
 

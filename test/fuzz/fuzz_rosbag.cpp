@@ -8,11 +8,11 @@
 #include <string>
 
 #include "featsense/slam/scan_source.hpp"
-#include "io/rosbag/bag_catalog.hpp"
-#include "io/rosbag/bag_record_reader.hpp"
-#include "io/rosbag/bag_topic_choice.hpp"
-#include "io/rosbag/pointcloud2_decoder.hpp"
-#include "io/rosbag/ros_serialization.hpp"
+#include "rosbag/bag_catalog.hpp"
+#include "rosbag/bag_record_reader.hpp"
+#include "rosbag/bag_topic_choice.hpp"
+#include "rosbag/pointcloud2_decoder.hpp"
+#include "rosbag/ros_serialization.hpp"
 
 namespace {
 

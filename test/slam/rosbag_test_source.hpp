@@ -14,7 +14,7 @@
 #include "common/test_data.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/config/sensor_model.hpp"
-#include "io/rosbag/rosbag_source.hpp"
+#include "rosbag/rosbag_source.hpp"
 
 namespace featsense::test {
 

@@ -14,9 +14,9 @@
 
 #include "common/test_data.hpp"
 #include "featsense/slam/scan_source.hpp"
-#include "io/rosbag/bag_catalog.hpp"
-#include "io/rosbag/bag_record_reader.hpp"
-#include "io/rosbag/bag_topic_choice.hpp"
+#include "rosbag/bag_catalog.hpp"
+#include "rosbag/bag_record_reader.hpp"
+#include "rosbag/bag_topic_choice.hpp"
 #include "slam/rosbag_test_writer.hpp"
 
 namespace featsense::slam {

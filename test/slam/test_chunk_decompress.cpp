@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "io/rosbag/chunk_decompress.hpp"
+#include "rosbag/chunk_decompress.hpp"
 #include "slam/rosbag_test_writer.hpp"
 
 namespace featsense::slam {

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "common/test_data.hpp"
+#include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/scan_source.hpp"
 
 namespace featsense::slam {

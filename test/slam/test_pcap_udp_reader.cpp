@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "featsense/slam/scan_source.hpp"
-#include "io/ouster/ip_reassembly.hpp"
-#include "io/ouster/pcap_udp_reader.hpp"
+#include "ouster/ip_reassembly.hpp"
+#include "ouster/pcap_udp_reader.hpp"
 #include "pcap_test_util.hpp"
 
 namespace featsense::slam {

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "io/rosbag/cloud_sensor_model.hpp"
-#include "io/rosbag/pointcloud2.hpp"
-#include "io/rosbag/pointcloud2_convert.hpp"
+#include "rosbag/cloud_sensor_model.hpp"
+#include "rosbag/pointcloud2.hpp"
+#include "rosbag/pointcloud2_convert.hpp"
 #include "slam/rosbag_test_clouds.hpp"
 
 namespace featsense::slam {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "io/rosbag/bag_record_reader.hpp"
-#include "io/rosbag/rosbag_source.hpp"
+#include "rosbag/bag_record_reader.hpp"
+#include "rosbag/rosbag_source.hpp"
 #include "slam/rosbag_test_clouds.hpp"
 #include "slam/rosbag_test_source.hpp"
 #include "slam/rosbag_test_writer.hpp"

@@ -13,7 +13,7 @@
 
 #include "common/test_data.hpp"
 #include "featsense/slam/io/readers.hpp"
-#include "io/rosbag/bag_record_reader.hpp"
+#include "rosbag/bag_record_reader.hpp"
 #include "slam/rosbag_test_source.hpp"
 #include "slam/rosbag_test_writer.hpp"
 

@@ -93,6 +93,42 @@ TEST(TrajectoryIo, ErrorsNameFileAndLine) {
             std::string::npos);
 }
 
+TEST(TrajectoryIo, TheFormatIsDetectedFromTheContent) {
+  const auto dir = scratch_dir("traj_io_detect");
+  const slam::Trajectory original = helix_trajectory(5, 1'700'000'000'000'000'000);
+  slam::write_tum(original, (dir / "poses.txt").string());
+  slam::write_kitti(original, (dir / "poses_kitti.txt").string());
+  EXPECT_EQ(slam::detect_trajectory_format((dir / "poses.txt").string()), "tum");
+  EXPECT_EQ(slam::detect_trajectory_format((dir / "poses_kitti.txt").string()), "kitti");
+  const slam::Trajectory tum = slam::read_trajectory((dir / "poses.txt").string());
+  EXPECT_TRUE(tum.has_stamps);
+  EXPECT_EQ(tum.size(), 5u);
+  const slam::Trajectory kitti = slam::read_trajectory((dir / "poses_kitti.txt").string());
+  EXPECT_FALSE(kitti.has_stamps);
+  EXPECT_EQ(kitti.size(), 5u);
+
+  write_text(dir / "odd.txt", "# comment\n\n1 2 3 4 5\n");
+  EXPECT_NE(error_of([&] {
+              slam::read_trajectory((dir / "odd.txt").string());
+            }).find("neither TUM (8) nor KITTI (12)"),
+            std::string::npos);
+  write_text(dir / "empty.txt", "# nothing\n");
+  EXPECT_NE(error_of([&] {
+              slam::detect_trajectory_format((dir / "empty.txt").string());
+            }).find("holds no pose"),
+            std::string::npos);
+  // A times file belongs to KITTI poses; TUM lines carry their own stamps.
+  write_text(dir / "times.txt", "0\n0.1\n0.2\n0.3\n0.4\n");
+  EXPECT_NE(error_of([&] {
+              slam::read_trajectory((dir / "poses.txt").string(), "auto",
+                                    (dir / "times.txt").string());
+            }).find("goes with KITTI poses"),
+            std::string::npos);
+  const slam::Trajectory timed = slam::read_trajectory((dir / "poses_kitti.txt").string(), "auto",
+                                                       (dir / "times.txt").string());
+  EXPECT_TRUE(timed.has_stamps);
+}
+
 TEST(TrajectoryIo, ReadsTheSharedKittiPoses) {
   FEATSENSE_SHARED_FILE(path, "ouster/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt");
   const slam::Trajectory t = slam::read_kitti(path.string());

@@ -1,0 +1,31 @@
+#pragma once
+/// Opening a recording of any supported format, detected from its content.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "featsense/slam/scan_source.hpp"
+
+namespace featsense::slam {
+
+struct SourceOptions {
+  std::optional<std::string> meta_path;  ///< Ouster metadata JSON (else found beside the pcap)
+  std::optional<std::string> topic;      ///< ROS bag topic (else the one scan topic there is)
+  std::string sensor_preset = "auto";    ///< config key sensor.preset
+  std::optional<double> min_range_m;     ///< config key sensor.min_range (else the sensor's)
+  std::optional<double> max_range_m;     ///< config key sensor.max_range (else the sensor's)
+};
+
+/// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the
+/// sensor) and non-finite points are invalid in every scan it hands out.
+std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source, double min_m,
+                                              double max_m);
+
+/// Opens a recording, detecting its format from the content: an Ouster pcap, a ROS1 bag, a
+/// PCD or PLY file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense simulate`.
+/// Returned scans already have the range limits applied. Throws InputError.
+std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
+                                             const SourceOptions& options = {});
+
+}  // namespace featsense::slam

@@ -1,0 +1,33 @@
+#pragma once
+/// One opener per format; open_scan_source() detects the format and calls one of these.
+/// Each throws InputError when the input cannot be read at all.
+
+#include <memory>
+#include <string>
+
+#include "featsense/slam/io/open_scan_source.hpp"
+#include "featsense/slam/scan_source.hpp"
+
+namespace featsense::slam {
+
+/// An Ouster pcap; the metadata JSON is options.meta_path, else the .json in the same folder
+/// whose name shares the longest prefix with the pcap's. Lidar packets are the UDP payloads of
+/// the size the metadata implies, on any port. A capture that yields no frame at all (no such
+/// packet, or cut before the first) throws InputError from next(), naming the sizes it saw; a
+/// capture cut later ends with a counted warning after the frames before the cut.
+std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path, const SourceOptions& options);
+/// A ROS1 bag (format 2.0): sensor_msgs/PointCloud2 or raw ouster_ros/PacketMsg topics.
+std::unique_ptr<ScanSource> open_rosbag(const std::string& path, const SourceOptions& options);
+/// One PCD file (one frame).
+std::unique_ptr<ScanSource> open_pcd_file(const std::string& path, const SourceOptions& options);
+/// One PLY point cloud (one frame).
+std::unique_ptr<ScanSource> open_ply_file(const std::string& path, const SourceOptions& options);
+/// A folder of scans: KITTI .bin, PCD or PLY files in name order, or a folder written by
+/// `featsense simulate` (it holds a sequence.yaml). Mixed formats are an error.
+std::unique_ptr<ScanSource> open_scan_folder(const std::string& path, const SourceOptions& options);
+
+/// The sensor model a reader should use for a recording without metadata: the preset named
+/// in options (when not "auto"), else `fallback_preset`.
+config::SensorModel sensor_for(const SourceOptions& options, const std::string& fallback_preset);
+
+}  // namespace featsense::slam

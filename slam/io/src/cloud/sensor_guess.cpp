@@ -1,0 +1,212 @@
+#include "cloud/sensor_guess.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "point_validity.hpp"
+
+namespace featsense::slam::cloud {
+namespace {
+
+struct RingPreset {
+  int beams;
+  const char* name;
+};
+/// Spinning sensors by beam count; 64 beams are taken for an HDL-64 (KITTI) rather than an
+/// OS1-64, the more common source of unorganized 64-beam clouds.
+constexpr RingPreset kRingPresets[] = {
+    {16, "vlp16"}, {32, "hdl32"}, {64, "hdl64"}, {128, "os1-128"}};
+
+constexpr size_t kMaxSampledPoints = 20000;
+constexpr double kMinFitFraction = 0.9;
+constexpr double kMinBeamsHitFraction = 0.5;
+
+double elevation_of(const Eigen::Vector3f& p) {
+  const Eigen::Vector3d q = p.cast<double>();
+  return std::atan2(q.z(), std::hypot(q.x(), q.y()));
+}
+
+double smallest_spacing(const std::vector<double>& elevation_rad) {
+  double smallest = M_PI;
+  for (size_t i = 1; i < elevation_rad.size(); ++i) {
+    const double gap = std::abs(elevation_rad[i - 1] - elevation_rad[i]);
+    if (gap > 0.0) smallest = std::min(smallest, gap);
+  }
+  return smallest;
+}
+
+}  // namespace
+
+const std::vector<config::SensorModel>& builtin_presets() {
+  static const std::vector<config::SensorModel> presets = [] {
+    std::vector<config::SensorModel> out;
+    for (const std::string& name : config::sensor_preset_names()) {
+      out.push_back(config::sensor_preset(name));
+    }
+    return out;
+  }();
+  return presets;
+}
+
+std::optional<std::string> preset_for_rings(int rings) {
+  for (const RingPreset& p : kRingPresets) {
+    if (rings <= p.beams) return std::string(p.name);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> preset_with_beams(int beams) {
+  for (const RingPreset& p : kRingPresets) {
+    if (beams == p.beams) return std::string(p.name);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> preset_fitting_rows(const std::vector<std::optional<double>>& rows) {
+  for (const config::SensorModel& preset : builtin_presets()) {
+    if (static_cast<size_t>(preset.beams) != rows.size()) continue;
+    const double tolerance = 0.25 * smallest_spacing(preset.elevation_rad);
+    bool fits = true;
+    for (size_t r = 0; r < rows.size() && fits; ++r) {
+      fits = !rows[r] || std::abs(*rows[r] - preset.elevation_rad[r]) <= tolerance;
+    }
+    if (fits) return preset.name;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
+  std::vector<double> elevations;
+  size_t data_points = 0;
+  for (const Eigen::Vector3f& p : cloud.xyz) data_points += is_return(p) ? 1 : 0;
+  const size_t step = std::max<size_t>(1, data_points / kMaxSampledPoints);
+  size_t seen = 0;
+  for (const Eigen::Vector3f& p : cloud.xyz) {
+    if (is_return(p) && seen++ % step == 0) elevations.push_back(elevation_of(p));
+  }
+  if (elevations.empty()) return std::nullopt;
+
+  std::optional<std::string> best;
+  int fitting = 0;
+  for (const config::SensorModel& preset : builtin_presets()) {
+    const std::vector<double>& beams = preset.elevation_rad;
+    if (beams.empty()) continue;
+    const double tolerance = 0.25 * smallest_spacing(beams);
+    std::vector<char> hit(beams.size(), 0);
+    size_t on_beam = 0;
+    for (double e : elevations) {
+      // Beams are listed from the highest down.
+      const auto below = std::lower_bound(beams.begin(), beams.end(), e, std::greater<double>());
+      for (auto it : {below, below == beams.begin() ? below : below - 1}) {
+        if (it != beams.end() && std::abs(*it - e) <= tolerance) {
+          ++on_beam;
+          hit[static_cast<size_t>(it - beams.begin())] = 1;
+          break;
+        }
+      }
+    }
+    const double fit = static_cast<double>(on_beam) / static_cast<double>(elevations.size());
+    const double beams_hit = static_cast<double>(std::count(hit.begin(), hit.end(), 1)) /
+                             static_cast<double>(beams.size());
+    if (fit >= kMinFitFraction && beams_hit >= kMinBeamsHitFraction) {
+      ++fitting;
+      best = preset.name;
+    }
+  }
+  return fitting == 1 ? best : std::nullopt;
+}
+
+namespace {
+
+/// Median elevation of the points of one row, nullopt when it has none.
+std::optional<double> row_elevation(const PointCloud& cloud, int width, int row,
+                                    std::vector<double>& scratch) {
+  scratch.clear();
+  const size_t start = static_cast<size_t>(row) * static_cast<size_t>(width);
+  for (size_t i = start; i < start + static_cast<size_t>(width) && i < cloud.xyz.size(); ++i) {
+    if (is_return(cloud.xyz[i])) scratch.push_back(elevation_of(cloud.xyz[i]));
+  }
+  if (scratch.empty()) return std::nullopt;
+  auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
+  std::nth_element(scratch.begin(), middle, scratch.end());
+  return *middle;
+}
+
+bool row_has_data(const PointCloud& cloud, int width, int row) {
+  const size_t start = static_cast<size_t>(row) * static_cast<size_t>(width);
+  for (size_t i = start; i < start + static_cast<size_t>(width) && i < cloud.xyz.size(); ++i) {
+    if (is_return(cloud.xyz[i])) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::optional<double>> row_elevations(const PointCloud& cloud, int width, int height) {
+  std::vector<std::optional<double>> rows;
+  std::vector<double> scratch;
+  for (int r = 0; r < height; ++r) rows.push_back(row_elevation(cloud, width, r, scratch));
+  return rows;
+}
+
+bool lowest_row_first(const PointCloud& cloud, int width, int height) {
+  int first = 0, last = height - 1;
+  while (first < height && !row_has_data(cloud, width, first)) ++first;
+  while (last > first && !row_has_data(cloud, width, last)) --last;
+  if (last <= first) return false;
+  std::vector<double> scratch;
+  return *row_elevation(cloud, width, first, scratch) < *row_elevation(cloud, width, last, scratch);
+}
+
+bool lowest_row_first(const std::vector<std::optional<double>>& elevation_rad) {
+  const auto first = std::find_if(elevation_rad.begin(), elevation_rad.end(),
+                                  [](const std::optional<double>& e) { return e.has_value(); });
+  const auto last = std::find_if(elevation_rad.rbegin(), elevation_rad.rend(),
+                                 [](const std::optional<double>& e) { return e.has_value(); });
+  return first != elevation_rad.end() && **first < **last;
+}
+
+std::optional<config::SensorModel> sensor_from_rows(
+    const std::vector<std::optional<double>>& elevation_rad, int columns) {
+  std::vector<size_t> measured;
+  for (size_t r = 0; r < elevation_rad.size(); ++r) {
+    if (elevation_rad[r]) measured.push_back(r);
+  }
+  if (measured.size() < 2) return std::nullopt;
+  config::SensorModel model;
+  model.name = "measured-" + std::to_string(elevation_rad.size()) + "x" + std::to_string(columns);
+  model.beams = static_cast<int>(elevation_rad.size());
+  model.columns = columns;
+  model.min_range_m = 0.0;
+  model.max_range_m = 1000.0;
+  // Linear through the two nearest measured rows (extrapolated at the ends).
+  for (size_t r = 0; r < elevation_rad.size(); ++r) {
+    if (elevation_rad[r]) {
+      model.elevation_rad.push_back(*elevation_rad[r]);
+      continue;
+    }
+    auto after = std::lower_bound(measured.begin(), measured.end(), r);
+    if (after == measured.end()) --after;
+    if (after == measured.begin()) ++after;
+    const size_t r0 = *(after - 1), r1 = *after;
+    const double e0 = *elevation_rad[r0], e1 = *elevation_rad[r1];
+    const double t = (static_cast<double>(r) - static_cast<double>(r0)) /
+                     (static_cast<double>(r1) - static_cast<double>(r0));
+    model.elevation_rad.push_back(e0 + t * (e1 - e0));
+  }
+  for (size_t r = 0; r < model.elevation_rad.size(); ++r) {
+    double& e = model.elevation_rad[r];
+    e = std::clamp(e, -M_PI / 2, M_PI / 2);
+    if (r > 0) e = std::min(e, model.elevation_rad[r - 1]);
+  }
+  model.azimuth_offset_rad.assign(elevation_rad.size(), 0.0);
+  try {
+    model.validate();
+  } catch (const std::exception&) {
+    return std::nullopt;  // too many rows or columns for a sensor
+  }
+  return model;
+}
+
+}  // namespace featsense::slam::cloud

@@ -1,0 +1,152 @@
+#include "rosbag/pointcloud2_decoder.hpp"
+
+#include <utility>
+
+#include "rosbag/cloud_sensor_model.hpp"
+#include "rosbag/pointcloud2.hpp"
+#include "rosbag/pointcloud2_convert.hpp"
+
+namespace featsense::slam {
+namespace {
+
+std::string describe_message(uint64_t index, const BagMessage& message) {
+  return "message " + std::to_string(index) + " (record at offset " +
+         std::to_string(message.offset) + ")";
+}
+
+/// What the first readable cloud of a topic tells about all of them.
+struct FirstCloud {
+  uint32_t height = 0;
+  uint32_t width = 0;
+  std::vector<std::string> fields;
+  int rings = 0;
+  std::optional<Scan> organized;  ///< row 0 the highest beam
+};
+
+FirstCloud read_first_cloud(const BagTopicContext& context) {
+  BagReadOptions options;
+  options.wanted = [&context](const BagMessage&, const BagConnection* connection) {
+    return connection != nullptr && connection->topic == context.topic.name;
+  };
+  std::string first_problem;
+  options.warn = [&first_problem](const std::string& message) {
+    if (first_problem.empty()) first_problem = message;
+  };
+  BagRecordReader reader(context.stream, context.origin, options);
+  for (const auto& [id, connection] : context.catalog.connections) {
+    reader.add_connection(connection);
+  }
+  uint64_t index = 0;
+  while (const std::optional<BagMessage> message = reader.next()) {
+    std::string problem;
+    try {
+      const PointCloud2View cloud = parse_pointcloud2(message->data);
+      problem = layout_problem(cloud);
+      if (problem.empty()) {
+        FirstCloud first;
+        first.height = cloud.height;
+        first.width = cloud.width;
+        for (const PointFieldDesc& field : cloud.fields) first.fields.push_back(field.name);
+        first.rings = ring_count(cloud);
+        if (cloud.height > 1) {
+          first.organized = organized_cloud_to_scan(cloud, message->time_ns);
+          if (rows_lowest_first(*first.organized).value_or(false)) flip_rows(*first.organized);
+        }
+        return first;
+      }
+    } catch (const SerializationError& e) {
+      problem = std::string("PointCloud2 ") + e.what();
+    }
+    if (first_problem.empty()) first_problem = describe_message(index, *message) + ": " + problem;
+    ++index;
+  }
+  std::string message =
+      context.origin + ": no readable PointCloud2 message on " + context.topic.name;
+  if (!first_problem.empty()) message += " (first problem: " + first_problem + ")";
+  throw InputError(message);
+}
+
+config::SensorModel choose_sensor(const BagTopicContext& context, const FirstCloud& first,
+                                  const SensorLookup& sensor_for, std::string& how) {
+  const SourceOptions& options = context.options;
+  if (options.sensor_preset != "auto") {
+    how = "sensor.preset " + options.sensor_preset;
+    return sensor_for(options, options.sensor_preset);
+  }
+  if (first.organized) {
+    if (const auto preset = preset_for_rings(static_cast<int>(first.height), false)) {
+      how = "preset " + *preset + " by its " + std::to_string(first.height) + " rows";
+      return sensor_for(options, *preset);
+    }
+    if (auto estimated = sensor_model_from_scan(*first.organized)) {
+      how = "sensor estimated from the first cloud's rows (no preset has " +
+            std::to_string(first.height) + " beams)";
+      return *estimated;
+    }
+    throw InputError(context.origin + ": the clouds on " + context.topic.name + " have " +
+                     std::to_string(first.height) +
+                     " rows, which no preset has, and too few returns to estimate the beams; "
+                     "set sensor.preset");
+  }
+  if (first.rings == 0) {
+    throw InputError(context.origin + ": the clouds on " + context.topic.name +
+                     " are unorganized and have no ring field; set sensor.preset to the "
+                     "sensor that recorded them");
+  }
+  if (const auto preset = preset_for_rings(first.rings, true)) {
+    how = "preset " + *preset + " by its " + std::to_string(first.rings) + " rings";
+    return sensor_for(options, *preset);
+  }
+  throw InputError(context.origin + ": the clouds on " + context.topic.name + " have " +
+                   std::to_string(first.rings) + " rings, more than any preset; set sensor.preset");
+}
+
+}  // namespace
+
+PointCloud2Decoder::PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize)
+    : sensor_(std::move(sensor)), organize_(std::move(organize)) {}
+
+std::optional<Scan> PointCloud2Decoder::decode(const BagMessage& message,
+                                               const DecodeReport& report) {
+  const uint64_t index = message_index_++;
+  PointCloud2View cloud;
+  try {
+    cloud = parse_pointcloud2(message.data);
+  } catch (const SerializationError& e) {
+    report.skip_frame(describe_message(index, message) + ": PointCloud2 " + e.what());
+    return std::nullopt;
+  }
+  if (const std::string problem = layout_problem(cloud); !problem.empty()) {
+    report.skip_frame(describe_message(index, message) + ": " + problem);
+    return std::nullopt;
+  }
+  Scan scan;
+  if (cloud.height > 1) {
+    scan = organized_cloud_to_scan(cloud, message.time_ns);
+    if (!lowest_first_) lowest_first_ = rows_lowest_first(scan);
+    if (lowest_first_.value_or(false)) flip_rows(scan);
+  } else {
+    scan = organize_(cloud_to_points(cloud, message.time_ns), sensor_);
+  }
+  scan.sequence = index;
+  return scan;
+}
+
+std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& context,
+                                                         CloudOrganizer organize,
+                                                         const SensorLookup& sensor_for,
+                                                         SourceInfo& info) {
+  const FirstCloud first = read_first_cloud(context);
+  std::string how;
+  config::SensorModel sensor = choose_sensor(context, first, sensor_for, how);
+  if (first.organized) sensor.columns = static_cast<int>(first.width);
+  info.sensor = sensor;
+  info.sensor_from_metadata = false;
+  info.fields = first.fields;
+  info.frames = static_cast<size_t>(context.topic.messages);
+  info.detail = (first.organized ? "organized " : "unorganized ") + std::to_string(first.height) +
+                " x " + std::to_string(first.width) + ", " + how;
+  return std::make_unique<PointCloud2Decoder>(std::move(sensor), std::move(organize));
+}
+
+}  // namespace featsense::slam

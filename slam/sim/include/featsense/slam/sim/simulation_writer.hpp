@@ -1,0 +1,61 @@
+#pragma once
+/// The output folder of `featsense simulate` (a recording the readers open, see
+/// slam/io/src/cloud/SEQUENCE_FORMAT.md) and its ground truth:
+///   frame_NNNNNN.pcd    one organized binary PCD per frame (ring, t, intensity channels)
+///   sequence.yaml       index of the frames and the sensor
+///   gt_trajectory.tum   T_map_sensor per frame at its stamp (column 0's time)
+///   gt_mesh.ply         the scene's triangles, binary PLY
+///   gt_points.ply       the noise-free surface points the sensor saw, over all frames,
+///                       thinned to one per voxel_size_m cube (the first seen), binary PLY
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+#include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/sim/lidar_simulator.hpp"
+#include "featsense/slam/sim/trajectory.hpp"
+#include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+
+namespace featsense::slam {
+
+class SimulationWriter {
+ public:
+  /// Creates `folder` (and parents). Throws WriteError naming it when that fails. Without
+  /// `write_frames` only the ground truth is written (the frames went straight to a consumer).
+  SimulationWriter(std::string folder, config::SensorModel sensor, double voxel_size_m = 0.02,
+                   bool write_frames = true);
+
+  /// Writes the frame's PCD and records its stamp, ground-truth pose and surface points.
+  void add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor);
+  /// Writes gt_trajectory.tum, gt_mesh.ply, gt_points.ply and (with frames) sequence.yaml.
+  void finish(const TriangleMesh& mesh);
+
+  size_t ground_truth_points() const { return points_.size(); }
+
+ private:
+  /// Inserts a voxel key; true when it was new.
+  bool insert_voxel(uint64_t key);
+
+  std::string folder_;
+  config::SensorModel sensor_;
+  double voxel_size_m_;
+  bool write_frames_;
+  std::vector<std::string> files_;
+  std::vector<int64_t> stamps_ns_;
+  Trajectory trajectory_;  ///< the true pose of each frame at its stamp
+  /// Occupied voxel keys, open addressing with linear probing (0 = empty slot; keys are
+  /// never 0): a node-based set spent more time than the simulation itself.
+  std::vector<uint64_t> voxel_slots_;
+  size_t voxel_count_ = 0;
+  std::vector<Eigen::Vector3f> points_;
+};
+
+/// Binary little-endian PLY of the mesh's vertices and triangles (metres). Throws WriteError.
+void write_mesh_ply(const TriangleMesh& mesh, const std::string& path);
+/// Binary little-endian PLY of points (metres). Throws WriteError.
+void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::string& path);
+
+}  // namespace featsense::slam

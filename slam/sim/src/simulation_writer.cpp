@@ -1,0 +1,157 @@
+#include "featsense/slam/sim/simulation_writer.hpp"
+
+#include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "featsense/config/config_error.hpp"
+#include "featsense/slam/io/scan_writers.hpp"
+#include "featsense/slam/io/sequence_file.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
+
+namespace featsense::slam {
+namespace {
+
+std::ofstream open_for_writing(const std::string& path) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw WriteError(path + ": cannot open for writing");
+  return out;
+}
+
+void close_checked(std::ofstream& out, const std::string& path) {
+  out.close();
+  if (!out) throw WriteError(path + ": writing failed (disk full?)");
+}
+
+/// Float32 values appended little-endian (the hosts this builds for are little-endian).
+void put_floats(std::string& out, const Eigen::Vector3f& v) {
+  out.append(reinterpret_cast<const char*>(v.data()), 3 * sizeof(float));
+}
+
+/// Voxel key: 21 bits per axis (+-1M voxels, +-20 km at 2 cm), bit 63 set so no key is 0.
+uint64_t voxel_key(const Eigen::Vector3f& p, double voxel_size_m) {
+  uint64_t key = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t v = static_cast<int64_t>(std::floor(p[k] / voxel_size_m)) + (1 << 20);
+    key = (key << 21) | (static_cast<uint64_t>(v) & 0x1FFFFFu);
+  }
+  return key | (1ull << 63);
+}
+
+uint64_t slot_hash(uint64_t key) {
+  key ^= key >> 33;
+  key *= 0xFF51AFD7ED558CCDull;
+  return key ^ (key >> 33);
+}
+
+/// True when `sensor` is a preset unchanged (the rate aside, which sequence.yaml states), so
+/// that sequence.yaml may name it; a changed sensor is written out in full.
+bool is_unchanged_preset(const config::SensorModel& sensor) {
+  try {
+    const config::SensorModel p = config::sensor_preset(sensor.name);
+    return p.beams == sensor.beams && p.columns == sensor.columns &&
+           p.elevation_rad == sensor.elevation_rad &&
+           p.azimuth_offset_rad == sensor.azimuth_offset_rad &&
+           p.beam_origin_offset_m == sensor.beam_origin_offset_m &&
+           p.min_range_m == sensor.min_range_m && p.max_range_m == sensor.max_range_m;
+  } catch (const config::ConfigError&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::string& path) {
+  std::ofstream out = open_for_writing(path);
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << points.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  std::string data;
+  data.reserve(points.size() * 12);
+  for (const Eigen::Vector3f& p : points) put_floats(data, p);
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  close_checked(out, path);
+}
+
+void write_mesh_ply(const TriangleMesh& mesh, const std::string& path) {
+  std::ofstream out = open_for_writing(path);
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+      << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string data;
+  data.reserve(mesh.vertices.size() * 12 + mesh.triangles.size() * 13);
+  for (const Eigen::Vector3f& v : mesh.vertices) put_floats(data, v);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    data.push_back(3);
+    data.append(reinterpret_cast<const char*>(t.data()), 3 * sizeof(int));
+  }
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  close_checked(out, path);
+}
+
+SimulationWriter::SimulationWriter(std::string folder, config::SensorModel sensor,
+                                   double voxel_size_m, bool write_frames)
+    : folder_(std::move(folder)),
+      sensor_(std::move(sensor)),
+      voxel_size_m_(voxel_size_m),
+      write_frames_(write_frames) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  if (ec) throw WriteError(folder_ + ": cannot create the folder: " + ec.message());
+}
+
+void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor) {
+  if (write_frames_) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%06zu.pcd", files_.size());
+    write_scan_pcd(frame.scan, (std::filesystem::path(folder_) / name).string());
+    files_.push_back(name);
+    stamps_ns_.push_back(frame.scan.stamp_ns);
+  }
+  trajectory_.push_back(frame.scan.stamp_ns, T_map_sensor);
+  for (const Eigen::Vector3f& p : frame.surface_points_m) {
+    if (insert_voxel(voxel_key(p, voxel_size_m_))) points_.push_back(p);
+  }
+}
+
+bool SimulationWriter::insert_voxel(uint64_t key) {
+  if (2 * (voxel_count_ + 1) > voxel_slots_.size()) {  // keep the load below one half
+    std::vector<uint64_t> old(std::max<size_t>(1 << 16, 2 * voxel_slots_.size()), 0);
+    old.swap(voxel_slots_);
+    voxel_count_ = 0;
+    for (uint64_t k : old) {
+      if (k != 0) insert_voxel(k);
+    }
+  }
+  const size_t mask = voxel_slots_.size() - 1;  // a power of two
+  for (size_t i = slot_hash(key) & mask;; i = (i + 1) & mask) {
+    if (voxel_slots_[i] == key) return false;
+    if (voxel_slots_[i] == 0) {
+      voxel_slots_[i] = key;
+      ++voxel_count_;
+      return true;
+    }
+  }
+}
+
+void SimulationWriter::finish(const TriangleMesh& mesh) {
+  const std::filesystem::path dir(folder_);
+  write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
+  write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());
+  write_points_ply(points_, (dir / "gt_points.ply").string());
+  if (!write_frames_) return;
+  cloud::SequenceFile sequence;
+  sequence.sensor = sensor_;
+  sequence.sensor_is_preset = is_unchanged_preset(sensor_);
+  sequence.rate_hz = sensor_.rate_hz;
+  for (size_t i = 0; i < files_.size(); ++i) sequence.frames.push_back({files_[i], stamps_ns_[i]});
+  const std::string yaml_path = (dir / "sequence.yaml").string();
+  std::ofstream yaml = open_for_writing(yaml_path);
+  yaml << cloud::format_sequence_yaml(sequence);
+  close_checked(yaml, yaml_path);
+}
+
+}  // namespace featsense::slam
