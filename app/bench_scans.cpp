@@ -1,36 +1,11 @@
 #include "bench_scans.hpp"
 
 #include <optional>
-#include <sstream>
-
-#include "featsense/config/config_error.hpp"
 
 #include "featsense/slam/sim/box_room_source.hpp"
 #include "scan_to_rays.hpp"
 
 namespace featsense::app {
-
-std::array<double, 3> parse_map_size(const std::string& text) {
-  std::array<double, 3> size{};
-  char x1 = 0;
-  char x2 = 0;
-  std::istringstream in(text);
-  if (!(in >> size[0] >> x1 >> size[1] >> x2 >> size[2]) || x1 != 'x' || x2 != 'x' || !in.eof()) {
-    throw config::ConfigError("--map: expected XxYxZ in metres, e.g. 40x40x15, got '" + text + "'");
-  }
-  return size;
-}
-
-config::Config bench_config(const CliContext& context, const std::array<double, 3>& map_size_m,
-                            double voxel_size_m, const std::string& backend) {
-  std::vector<std::string> overrides = context.overrides;
-  std::ostringstream set_size;
-  set_size << "map.size=[" << map_size_m[0] << "," << map_size_m[1] << "," << map_size_m[2] << "]";
-  overrides.push_back(set_size.str());
-  overrides.push_back("map.voxel_size=" + std::to_string(voxel_size_m));
-  overrides.push_back("map.backend=" + backend);
-  return config::load_config(context.config_path, overrides);
-}
 
 PreparedScans prepare_builtin(const std::string& scene, int count) {
   slam::BoxRoomSettings settings = slam::default_box_room();

@@ -2,24 +2,15 @@
 // The scans the benchmarks integrate: built-in OS1-128 scans of an analytic scene, or the
 // first frames of a recording.
 
-#include <array>
 #include <string>
 #include <vector>
 
-#include "cli_context.hpp"
 #include "featsense/config/config.hpp"
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
 #include "source_options.hpp"
 
 namespace featsense::app {
-
-/// --map XxYxZ (metres). Throws ConfigError.
-std::array<double, 3> parse_map_size(const std::string& text);
-
-/// The run's configuration with the benchmark's map size, voxel size and backend.
-config::Config bench_config(const CliContext& context, const std::array<double, 3>& map_size_m,
-                            double voxel_size_m, const std::string& backend);
 
 /// Scans as rays in the map frame, ready to integrate.
 struct PreparedScans {
