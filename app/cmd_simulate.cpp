@@ -135,7 +135,7 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   const PreparedSimulation prepared(o);
   const slam::LidarSimulator& simulator = *prepared.simulator;
   const slam::SimulationSettings& settings = simulator.settings();
-  const slam::TriangleMesh& mesh = prepared.mesh;
+  const mesh::TriangleMesh& mesh = prepared.mesh;
   const uint64_t frames = prepared.frames;
   const slam::PoseCurve* trajectory = prepared.trajectory.get();
 

@@ -6,10 +6,10 @@
 #include <string>
 
 #include "cli_context.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/ray_caster.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
-#include "featsense/slam/sim/triangle_mesh.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 
 namespace featsense::app {
@@ -40,7 +40,7 @@ struct PreparedSimulation {
   PreparedSimulation(const PreparedSimulation&) = delete;
   PreparedSimulation& operator=(const PreparedSimulation&) = delete;
 
-  slam::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   std::unique_ptr<slam::PoseCurve> trajectory;
   std::unique_ptr<slam::RayCaster> caster;
   std::unique_ptr<slam::LidarSimulator> simulator;

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "featsense/config/sensor_model.hpp"
-#include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 
 namespace featsense::test {
 
@@ -36,8 +36,8 @@ struct Box {
   Eigen::Vector3d hi{6.0, 4.0, 3.0};
 };
 
-inline slam::TriangleMesh box_mesh(const Box& box) {
-  slam::TriangleMesh mesh;
+inline mesh::TriangleMesh box_mesh(const Box& box) {
+  mesh::TriangleMesh mesh;
   const uint32_t part = mesh.add_part("wall", 0.6f);
   mesh.add_box(box.lo.cast<float>(), box.hi.cast<float>(), part);
   return mesh;

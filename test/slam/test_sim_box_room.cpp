@@ -15,7 +15,7 @@ using test::Box;
 
 struct BoxScene {
   Box box;
-  TriangleMesh mesh = test::box_mesh(box);
+  mesh::TriangleMesh mesh = test::box_mesh(box);
   RayCaster caster{mesh};
 };
 
@@ -147,7 +147,7 @@ double distance_outside(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
 TEST(SimBoxRoom, MixedPixelsLieBetweenAnEdgeAndTheSurfaceBehindIt) {
   // The room with a pillar: its vertical edges are depth discontinuities, nothing else is.
   const Box box;
-  TriangleMesh mesh = test::box_mesh(box);
+  mesh::TriangleMesh mesh = test::box_mesh(box);
   const Eigen::Vector3d pillar_lo(2.0, -0.5, 0.0);
   const Eigen::Vector3d pillar_hi(2.6, 0.1, 3.0);
   mesh.add_box(pillar_lo.cast<float>(), pillar_hi.cast<float>(), 0);

@@ -27,7 +27,7 @@ std::string read_bytes(const std::filesystem::path& path) {
 
 /// Two frames of the lab scene (noise, drop-outs and mixed pixels on) into `dir`.
 void simulate_lab(const std::filesystem::path& dir, uint64_t seed) {
-  const TriangleMesh mesh = build_scene("lab");
+  const mesh::TriangleMesh mesh = build_scene("lab");
   const RayCaster caster(mesh);
   const NamedPath path = scene_path("lab", "drone");
   const auto trajectory = make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);

@@ -29,7 +29,7 @@ std::string write_file(const std::filesystem::path& dir, const std::string& name
 
 TEST(SimMeshLoader, ReadsAPlyBoxWithItsSize) {
   const auto dir = test::scratch_dir("sim_mesh_ply");
-  const TriangleMesh mesh = load_mesh(write_file(dir, "box.ply", kBoxPly));
+  const mesh::TriangleMesh mesh = load_mesh(write_file(dir, "box.ply", kBoxPly));
   EXPECT_EQ(mesh.triangle_count(), 12u);
   Eigen::Vector3f lo, hi;
   mesh.bounds(&lo, &hi);
@@ -47,7 +47,7 @@ TEST(SimMeshLoader, ObjWithUnitScaleAndUpAxis) {
   MeshLoadOptions options;
   options.unit_scale = 0.01;
   options.up_axis = "z";
-  TriangleMesh mesh = load_mesh(path, options);
+  mesh::TriangleMesh mesh = load_mesh(path, options);
   ASSERT_EQ(mesh.triangle_count(), 1u);
   Eigen::Vector3f lo, hi;
   mesh.bounds(&lo, &hi);
@@ -92,7 +92,7 @@ TEST(SimMeshLoader, ColladaSaysItsUpAxisAndUnit) {
   const std::string y_up =
       write_file(dir, "y_up.dae", collada_triangle("Y_UP", 1.0, "0 0 0 1 0 0 0 2 0"));
   for (const std::string& path : {z_up, y_up}) {
-    const TriangleMesh mesh = load_mesh(path);
+    const mesh::TriangleMesh mesh = load_mesh(path);
     ASSERT_EQ(mesh.triangle_count(), 1u) << path;
     Eigen::Vector3f lo, hi;
     mesh.bounds(&lo, &hi);
@@ -105,9 +105,9 @@ TEST(SimMeshLoader, ColladaSaysItsUpAxisAndUnit) {
 
 TEST(SimMeshLoader, WrittenGroundTruthMeshReadsBack) {
   const auto dir = test::scratch_dir("sim_mesh_roundtrip");
-  const TriangleMesh scene = build_scene("corridor");
+  const mesh::TriangleMesh scene = build_scene("corridor");
   write_mesh_ply(scene, (dir / "scene.ply").string());
-  const TriangleMesh back = load_mesh((dir / "scene.ply").string());
+  const mesh::TriangleMesh back = load_mesh((dir / "scene.ply").string());
   EXPECT_EQ(back.triangle_count(), scene.triangle_count());
   Eigen::Vector3f lo, hi;
   back.bounds(&lo, &hi);
@@ -119,13 +119,13 @@ TEST(SimMeshLoader, SharedSceneMeshes) {
   FEATSENSE_SHARED_FILE(house, "scenes/small_house.ply");
   FEATSENSE_SHARED_FILE(station, "scenes/gas_station_with_ground.ply");
   Eigen::Vector3f lo, hi;
-  const TriangleMesh h = load_mesh(house.string());
+  const mesh::TriangleMesh h = load_mesh(house.string());
   EXPECT_EQ(h.triangle_count(), 147620u);  // the data's README
   h.bounds(&lo, &hi);
   EXPECT_NEAR(lo.z(), 0.0f, 0.05f);           // floor at z = 0
   EXPECT_NEAR(hi.x() - lo.x(), 19.0f, 2.0f);  // about 19 x 11 m
   EXPECT_NEAR(hi.y() - lo.y(), 11.0f, 2.0f);
-  const TriangleMesh s = load_mesh(station.string());
+  const mesh::TriangleMesh s = load_mesh(station.string());
   EXPECT_EQ(s.triangle_count(), 4942u);
   s.bounds(&lo, &hi);
   EXPECT_NEAR(hi.x() - lo.x(), 80.0f, 1.0f);  // the 80 x 80 m ground quad

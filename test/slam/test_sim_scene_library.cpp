@@ -11,8 +11,8 @@ namespace {
 
 TEST(SimSceneLibrary, ScenesAreTheSameOnEveryBuild) {
   for (const std::string& name : scene_names()) {
-    const TriangleMesh a = build_scene(name);
-    const TriangleMesh b = build_scene(name);
+    const mesh::TriangleMesh a = build_scene(name);
+    const mesh::TriangleMesh b = build_scene(name);
     ASSERT_GT(a.triangle_count(), 0u) << name;
     ASSERT_EQ(a.vertices.size(), b.vertices.size()) << name;
     for (size_t i = 0; i < a.vertices.size(); ++i) ASSERT_EQ(a.vertices[i], b.vertices[i]) << name;
@@ -30,7 +30,7 @@ TEST(SimSceneLibrary, SizesAsSpecified) {
   build_scene("parking").bounds(&lo, &hi);
   EXPECT_GE(hi.x() - lo.x(), 90.0f);  // the 90 x 30 m lot and the buildings around it
   EXPECT_GE(hi.y() - lo.y(), 30.0f);
-  const TriangleMesh parking = build_scene("parking");
+  const mesh::TriangleMesh parking = build_scene("parking");
   size_t foliage = 0;
   for (size_t t = 0; t < parking.triangle_count(); ++t) {
     if (parking.parts[parking.triangle_part[t]].name == "foliage") {
@@ -47,7 +47,7 @@ TEST(SimSceneLibrary, SizesAsSpecified) {
 
 TEST(SimSceneLibrary, NamedPathsStayInsideAndClearOfObstacles) {
   for (const std::string& scene : scene_names()) {
-    const TriangleMesh mesh = build_scene(scene);
+    const mesh::TriangleMesh mesh = build_scene(scene);
     const RayCaster caster(mesh);
     for (const std::string& name : path_names()) {
       const NamedPath path = scene_path(scene, name);

@@ -27,7 +27,7 @@ void beam_geometry(const config::SensorModel& sensor, int row, int col, Eigen::V
   *origin = sensor.beam_origin_offset_m * Eigen::Vector3d(std::cos(encoder), std::sin(encoder), 0);
 }
 
-LidarSimulator::LidarSimulator(const TriangleMesh& mesh, const RayCaster& caster,
+LidarSimulator::LidarSimulator(const mesh::TriangleMesh& mesh, const RayCaster& caster,
                                const PoseCurve& trajectory, SimulationSettings settings)
     : mesh_(mesh), caster_(caster), trajectory_(trajectory), settings_(std::move(settings)) {
   settings_.sensor.validate();
@@ -158,8 +158,8 @@ SimulatedFrame LidarSimulator::simulate(uint64_t index) const {
   return frame;
 }
 
-void check_trajectory_inside(const PoseCurve& trajectory, const TriangleMesh& mesh, double end_s,
-                             double step_s, double margin_m) {
+void check_trajectory_inside(const PoseCurve& trajectory, const mesh::TriangleMesh& mesh,
+                             double end_s, double step_s, double margin_m) {
   Eigen::Vector3f lo, hi;
   mesh.bounds(&lo, &hi);
   const Eigen::Vector3d lo_m = lo.cast<double>() - Eigen::Vector3d::Constant(margin_m);

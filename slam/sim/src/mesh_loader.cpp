@@ -44,7 +44,7 @@ float material_reflectance(const aiMaterial* material, float fallback) {
 
 }  // namespace
 
-TriangleMesh load_mesh(const std::string& path, const MeshLoadOptions& options) {
+mesh::TriangleMesh load_mesh(const std::string& path, const MeshLoadOptions& options) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": no such mesh file");
   if (!std::ifstream(path)) throw InputError(path + ": cannot read the mesh file");
   if (!(options.unit_scale > 0.0)) throw InputError(path + ": unit scale must be > 0");
@@ -60,7 +60,7 @@ TriangleMesh load_mesh(const std::string& path, const MeshLoadOptions& options) 
   if (scene == nullptr)
     throw InputError(path + ": cannot read the mesh: " + importer.GetErrorString());
 
-  TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   const float scale = static_cast<float>(options.unit_scale);
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* part = scene->mMeshes[m];

@@ -22,7 +22,7 @@ struct RayCaster::Impl {
   }
 };
 
-RayCaster::RayCaster(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+RayCaster::RayCaster(const mesh::TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr)
     throw std::runtime_error("ray tracer: cannot create an Embree device (error " +

@@ -31,14 +31,16 @@ float draw(uint64_t stream, uint32_t a, uint32_t b, float lo, float hi) {
 }
 
 /// Vertical walls: in the plane x = const from y0 to y1, or y = const from x0 to x1.
-void add_wall_x(TriangleMesh& m, float x, float y0, float y1, float z0, float z1, uint32_t part) {
+void add_wall_x(mesh::TriangleMesh& m, float x, float y0, float y1, float z0, float z1,
+                uint32_t part) {
   m.add_quad(V(x, y0, z0), V(x, y1, z0), V(x, y1, z1), V(x, y0, z1), part);
 }
-void add_wall_y(TriangleMesh& m, float y, float x0, float x1, float z0, float z1, uint32_t part) {
+void add_wall_y(mesh::TriangleMesh& m, float y, float x0, float x1, float z0, float z1,
+                uint32_t part) {
   m.add_quad(V(x0, y, z0), V(x1, y, z0), V(x1, y, z1), V(x0, y, z1), part);
 }
 
-void add_table(TriangleMesh& m, float x0, float y0, float x1, float y1, uint32_t part) {
+void add_table(mesh::TriangleMesh& m, float x0, float y0, float x1, float y1, uint32_t part) {
   m.add_box(V(x0, y0, 0.72f), V(x1, y1, 0.76f), part);
   const float leg = 0.05f;
   for (float x : {x0, x1 - leg}) {
@@ -47,7 +49,7 @@ void add_table(TriangleMesh& m, float x0, float y0, float x1, float y1, uint32_t
 }
 
 /// Open shelving: two side panels, a back panel and five shelves, front facing -y.
-void add_shelving(TriangleMesh& m, float x0, float x1, float y0, float depth, uint32_t part) {
+void add_shelving(mesh::TriangleMesh& m, float x0, float x1, float y0, float depth, uint32_t part) {
   const float height = 2.2f;
   const float t = 0.03f;
   m.add_box(V(x0, y0, 0), V(x0 + t, y0 + depth, height), part);
@@ -61,7 +63,8 @@ void add_shelving(TriangleMesh& m, float x0, float x1, float y0, float depth, ui
 
 /// A tree: a trunk and a crown of many small irregular facets (as foliage gives lidar
 /// returns that change from scan to scan).
-void add_tree(TriangleMesh& m, float x, float y, uint32_t index, uint32_t trunk, uint32_t foliage) {
+void add_tree(mesh::TriangleMesh& m, float x, float y, uint32_t index, uint32_t trunk,
+              uint32_t foliage) {
   m.add_cylinder(V(x, y, 0), 0.15f, 2.6f, 8, trunk);
   const V centre(x, y, 4.2f);
   const float radius = draw(1, index, 0, 1.6f, 2.2f);
@@ -87,7 +90,7 @@ void add_tree(TriangleMesh& m, float x, float y, uint32_t index, uint32_t trunk,
 }
 
 /// A car parked with its length along y: body, cabin, wheels.
-void add_car(TriangleMesh& m, float x, float y0, uint32_t index, uint32_t tyre) {
+void add_car(mesh::TriangleMesh& m, float x, float y0, uint32_t index, uint32_t tyre) {
   static const float kPaint[] = {0.04f, 0.3f, 0.55f, 0.85f, 0.2f};  // black ... white
   const uint32_t paint = m.add_part("car body", kPaint[index % 5]);
   const uint32_t glass = m.add_part("car window", Materials::kGlass);
@@ -101,7 +104,7 @@ void add_car(TriangleMesh& m, float x, float y0, uint32_t index, uint32_t tyre) 
   }
 }
 
-void add_light_pole(TriangleMesh& m, float x, float y, uint32_t metal) {
+void add_light_pole(mesh::TriangleMesh& m, float x, float y, uint32_t metal) {
   m.add_cylinder(V(x, y, 0), 0.1f, 8.0f, 10, metal);
   m.add_box(V(x - 0.05f, y - 0.05f, 7.9f), V(x + 1.5f, y + 0.05f, 8.0f), metal);
   m.add_box(V(x + 1.1f, y - 0.25f, 7.7f), V(x + 1.7f, y + 0.25f, 7.9f), metal);
@@ -109,8 +112,8 @@ void add_light_pole(TriangleMesh& m, float x, float y, uint32_t metal) {
 
 /// 20 x 20 x 4 m room (x, y in [-10, 10]) with pillars, tables, shelving, a closed door in
 /// the west wall and an open door (1.2 x 2.2 m) in the east wall to a 2 m wide corridor.
-TriangleMesh lab() {
-  TriangleMesh m;
+mesh::TriangleMesh lab() {
+  mesh::TriangleMesh m;
   const uint32_t wall = m.add_part("wall", Materials::kPlaster);
   const uint32_t floor = m.add_part("floor", Materials::kFloorTiles);
   const uint32_t ceiling = m.add_part("ceiling", Materials::kPlaster);
@@ -149,8 +152,8 @@ TriangleMesh lab() {
 }
 
 /// A 60 m long, 2.5 m wide, 2.8 m high hallway, closed at both ends: plain walls only.
-TriangleMesh corridor() {
-  TriangleMesh m;
+mesh::TriangleMesh corridor() {
+  mesh::TriangleMesh m;
   const uint32_t wall = m.add_part("wall", Materials::kPlaster);
   const uint32_t floor = m.add_part("floor", Materials::kFloorTiles);
   m.add_quad(V(0, -1.25f, 0), V(60, -1.25f, 0), V(60, 1.25f, 0), V(0, 1.25f, 0), floor);
@@ -164,8 +167,8 @@ TriangleMesh corridor() {
 
 /// A 90 x 30 m lot (x in [0, 90], y in [0, 30]): three rows of cars, kerbs, light poles,
 /// trees, a ramp up to a deck, and building facades to the north and east.
-TriangleMesh parking() {
-  TriangleMesh m;
+mesh::TriangleMesh parking() {
+  mesh::TriangleMesh m;
   const uint32_t asphalt = m.add_part("asphalt", Materials::kAsphalt);
   const uint32_t concrete = m.add_part("kerb", Materials::kConcrete);
   const uint32_t facade = m.add_part("facade", Materials::kConcrete);
@@ -245,7 +248,7 @@ bool is_builtin_scene(const std::string& name) {
   return false;
 }
 
-TriangleMesh build_scene(const std::string& name) {
+mesh::TriangleMesh build_scene(const std::string& name) {
   if (name == "lab") return lab();
   if (name == "parking") return parking();
   if (name == "corridor") return corridor();

@@ -76,7 +76,7 @@ void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::str
   close_checked(out, path);
 }
 
-void write_mesh_ply(const TriangleMesh& mesh, const std::string& path) {
+void write_mesh_ply(const mesh::TriangleMesh& mesh, const std::string& path) {
   std::ofstream out = open_for_writing(path);
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.vertices.size()
       << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
@@ -137,7 +137,7 @@ bool SimulationWriter::insert_voxel(uint64_t key) {
   }
 }
 
-void SimulationWriter::finish(const TriangleMesh& mesh) {
+void SimulationWriter::finish(const mesh::TriangleMesh& mesh) {
   const std::filesystem::path dir(folder_);
   write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
   write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());

@@ -36,8 +36,8 @@ class LidarSimulator {
  public:
   /// The caster and trajectory must outlive the simulator. Throws ConfigError for an
   /// inconsistent sensor.
-  LidarSimulator(const TriangleMesh& mesh, const RayCaster& caster, const PoseCurve& trajectory,
-                 SimulationSettings settings);
+  LidarSimulator(const mesh::TriangleMesh& mesh, const RayCaster& caster,
+                 const PoseCurve& trajectory, SimulationSettings settings);
 
   /// Frame `index` (0-based): column c is fired at trajectory time
   /// (index + c / columns) / rate_hz seconds.
@@ -47,7 +47,7 @@ class LidarSimulator {
   const SimulationSettings& settings() const { return settings_; }
 
  private:
-  const TriangleMesh& mesh_;
+  const mesh::TriangleMesh& mesh_;
   const RayCaster& caster_;
   const PoseCurve& trajectory_;
   SimulationSettings settings_;
@@ -65,7 +65,7 @@ void beam_geometry(const config::SensorModel& sensor, int row, int col, Eigen::V
 /// Throws std::invalid_argument naming the time and position when the sensor leaves the
 /// mesh's bounding box (grown by margin_m) at some time in [0, end_s] (checked every
 /// step_s seconds and at end_s).
-void check_trajectory_inside(const PoseCurve& trajectory, const TriangleMesh& mesh, double end_s,
-                             double step_s = 0.01, double margin_m = 0.0);
+void check_trajectory_inside(const PoseCurve& trajectory, const mesh::TriangleMesh& mesh,
+                             double end_s, double step_s = 0.01, double margin_m = 0.0);
 
 }  // namespace featsense::slam

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 
 namespace featsense::slam {
 
@@ -18,6 +18,6 @@ struct MeshLoadOptions {
 /// The mesh of `path` in metres, Z up. Each of the file's meshes becomes a part whose
 /// reflectance is the mean of its material's diffuse colour (else the default).
 /// Throws InputError naming the file when it is missing, unreadable or holds no triangle.
-TriangleMesh load_mesh(const std::string& path, const MeshLoadOptions& options = {});
+mesh::TriangleMesh load_mesh(const std::string& path, const MeshLoadOptions& options = {});
 
 }  // namespace featsense::slam

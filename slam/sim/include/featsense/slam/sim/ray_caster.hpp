@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-#include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 
 namespace featsense::slam {
 
@@ -32,7 +32,7 @@ class RayCaster {
  public:
   /// Builds the acceleration structure over `mesh` (copied). Throws std::runtime_error when
   /// the ray tracer cannot be set up.
-  explicit RayCaster(const TriangleMesh& mesh);
+  explicit RayCaster(const mesh::TriangleMesh& mesh);
   ~RayCaster();
   RayCaster(const RayCaster&) = delete;
   RayCaster& operator=(const RayCaster&) = delete;

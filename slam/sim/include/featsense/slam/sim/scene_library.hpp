@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "featsense/slam/sim/triangle_mesh.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 
 namespace featsense::slam {
 
@@ -17,7 +17,7 @@ std::vector<std::string> scene_names();
 bool is_builtin_scene(const std::string& name);
 /// The scene's mesh (map frame, metres, Z up, floor at z = 0). Throws std::invalid_argument
 /// naming the scenes when `name` is unknown.
-TriangleMesh build_scene(const std::string& name);
+mesh::TriangleMesh build_scene(const std::string& name);
 
 /// A sensor path: waypoints (map frame, metres) travelled at constant speed.
 struct NamedPath {

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/mesh/triangle_mesh.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
-#include "featsense/slam/sim/triangle_mesh.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 
 namespace featsense::slam {
@@ -31,7 +31,7 @@ class SimulationWriter {
   /// Writes the frame's PCD and records its stamp, ground-truth pose and surface points.
   void add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor);
   /// Writes gt_trajectory.tum, gt_mesh.ply, gt_points.ply and (with frames) sequence.yaml.
-  void finish(const TriangleMesh& mesh);
+  void finish(const mesh::TriangleMesh& mesh);
 
   size_t ground_truth_points() const { return points_.size(); }
 
@@ -54,7 +54,7 @@ class SimulationWriter {
 };
 
 /// Binary little-endian PLY of the mesh's vertices and triangles (metres). Throws WriteError.
-void write_mesh_ply(const TriangleMesh& mesh, const std::string& path);
+void write_mesh_ply(const mesh::TriangleMesh& mesh, const std::string& path);
 /// Binary little-endian PLY of points (metres). Throws WriteError.
 void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::string& path);
 
