@@ -20,12 +20,12 @@
 #include "featsense/slam/io/ouster_metadata.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
-#include "featsense/slam/sim/mesh_loader.hpp"
 #include "featsense/slam/sim/ray_caster.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/viewer_export/assimp_mesh_io.hpp"
 #include "progress.hpp"
 #include "simulate_job.hpp"
 
@@ -83,10 +83,12 @@ PreparedSimulation::PreparedSimulation(const SimulateOptions& o) {
     throw slam::InputError(o.scene + ": no such mesh file, and no built-in scene of that name (" +
                            names + ")");
   }
-  slam::MeshLoadOptions load;
+  viewer_export::AssimpReadOptions load;
   load.unit_scale = o.unit_scale;
   load.up_axis = o.up_axis;
-  mesh = builtin ? slam::build_scene(o.scene) : slam::load_mesh(o.scene, load);
+  load.surfaces_only = true;
+  mesh = builtin ? slam::build_scene(o.scene)
+                 : viewer_export::read_mesh_with_assimp(o.scene, nullptr, load);
   slam::SimulationSettings settings;
   trajectory = make_trajectory(o, builtin, &settings.start_stamp_ns);
 

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <filesystem>
 
+#include "featsense/viewer_export/assimp_mesh_io.hpp"
 #include "featsense/viewer_export/gltf_mesh_io.hpp"
 #include "featsense/viewer_export/mesh_nav_h5_io.hpp"
 #include "featsense/viewer_export/obj_mesh_io.hpp"

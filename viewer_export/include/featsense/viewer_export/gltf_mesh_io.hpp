@@ -10,6 +10,7 @@
 /// (`featsense_origin_map_m`). Per vertex: POSITION, NORMAL (given or area-weighted), COLOR_0
 /// (RGBA bytes) where colours are present, and each scalar layer as an application-specific
 /// float attribute `_<NAME>` (upper case). A mesh without triangles is written as points.
+/// Reading them back: `read_mesh_with_assimp` (assimp_mesh_io.hpp).
 
 #include <string>
 
@@ -23,11 +24,5 @@ namespace featsense::viewer_export {
 /// MeshFileError naming the file.
 void write_gltf_mesh(const std::string& path, const mesh::TriangleMesh& mesh,
                      const MeshAttributes& attributes, bool binary);
-
-/// Reads any file assimp imports (glTF, GLB, OBJ, ...), applying the node transforms in double
-/// precision; glTF files are turned back from Y up into our Z-up map frame. Colours go to
-/// `attributes` where given. Throws MeshFileError naming the file.
-mesh::TriangleMesh read_mesh_with_assimp(const std::string& path,
-                                         MeshAttributes* attributes = nullptr);
 
 }  // namespace featsense::viewer_export
