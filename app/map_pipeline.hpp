@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "featsense/config/config.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
@@ -36,7 +37,7 @@ struct LocatedScan {
 
 struct PipelineSettings {
   size_t queue_capacity = 4;  ///< scans per queue
-  double flush_interval_s = 30.0;
+  double flush_interval_s = config::MapConfig{}.flush_interval_s;  ///< map.flush_interval
   FrameRange range;
   std::optional<size_t> total_frames;  ///< for the progress display, when known
   bool drop_mixed_pixels = true;       ///< sensor.drop_mixed_pixels
