@@ -109,7 +109,14 @@ TEST(CliEval, TrajErrorsAreClear) {
   const CommandResult bad =
       run_featsense("eval traj " + (dir / "bad.tum").string() + " " + (dir / "gt.tum").string());
   EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_NE(bad.output.find("bad.tum:1: expected 8 numbers"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("bad.tum:1: a line of 3 numbers is neither TUM (8) nor KITTI (12)"),
+            std::string::npos)
+      << bad.output;
+  const CommandResult bad_tum = run_featsense(
+      "eval traj --format tum " + (dir / "bad.tum").string() + " " + (dir / "gt.tum").string());
+  EXPECT_EQ(bad_tum.exit_code, 1);
+  EXPECT_NE(bad_tum.output.find("bad.tum:1: expected 8 numbers"), std::string::npos)
+      << bad_tum.output;
 }
 
 TEST(CliEval, MeshReportsAccuracyCompletenessAndWritesScalarFields) {

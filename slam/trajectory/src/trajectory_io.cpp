@@ -137,7 +137,7 @@ std::string detect_trajectory_format(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw TrajectoryError("cannot open trajectory " + path);
   std::string line;
-  while (std::getline(in, line)) {
+  for (size_t number = 1; std::getline(in, line); ++number) {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream fields(line);
     size_t count = 0;
@@ -145,8 +145,8 @@ std::string detect_trajectory_format(const std::string& path) {
     if (count == 0) continue;
     if (count == 8) return "tum";
     if (count == 12) return "kitti";
-    throw TrajectoryError(path + ": a line of " + std::to_string(count) +
-                          " numbers is neither TUM (8) nor KITTI (12)");
+    throw TrajectoryError(path + ":" + std::to_string(number) + ": a line of " +
+                          std::to_string(count) + " numbers is neither TUM (8) nor KITTI (12)");
   }
   throw TrajectoryError(path + " holds no pose");
 }
