@@ -18,10 +18,24 @@ find_package(OpenVDB REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
-# The simulator: Embree casts the rays, assimp reads scene meshes (slam/src/sim); assimp also
-# reads glTF/OBJ meshes back in viewer_export.
+# The simulator: Embree casts the rays (slam/sim); assimp reads mesh files (viewer_export), the
+# simulator's scene files among them.
 find_package(embree 3 CONFIG REQUIRED)
 find_package(assimp CONFIG REQUIRED)
 # CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings
 # never fail our build. Only mesh/src/closest_point_query.cpp includes it.
 find_package(CGAL CONFIG REQUIRED)
+
+# The front end (slam/features, slam/odometry): OpenCV's core and imgproc for the intensity
+# image (Debian's two packages ship no CMake config, and the full libopencv-dev pulls in about
+# 160 packages), Ceres for the registration, nanoflann for nearest neighbours.
+find_path(FEATSENSE_OPENCV_INCLUDE_DIR opencv2/imgproc.hpp PATH_SUFFIXES opencv4 REQUIRED)
+find_library(FEATSENSE_OPENCV_CORE_LIBRARY opencv_core REQUIRED)
+find_library(FEATSENSE_OPENCV_IMGPROC_LIBRARY opencv_imgproc REQUIRED)
+add_library(featsense_opencv INTERFACE)
+add_library(featsense::opencv ALIAS featsense_opencv)
+target_include_directories(featsense_opencv SYSTEM INTERFACE ${FEATSENSE_OPENCV_INCLUDE_DIR})
+target_link_libraries(featsense_opencv INTERFACE ${FEATSENSE_OPENCV_IMGPROC_LIBRARY}
+                                                 ${FEATSENSE_OPENCV_CORE_LIBRARY})
+find_package(Ceres CONFIG REQUIRED)
+find_package(nanoflann CONFIG REQUIRED)
