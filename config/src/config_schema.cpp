@@ -181,6 +181,40 @@ std::vector<KeySpec> make_specs() {
       bool_key("map.carve_free_space", &Config::map, &MapConfig::carve_free_space),
       number_key("map.flush_interval", &Config::map, &MapConfig::flush_interval_s, {1.0, 86400.0}),
       backend_key(),
+      integer_key("features.neighbours", &Config::features, &FeaturesConfig::neighbours, 1, 20),
+      integer_key("features.sectors", &Config::features, &FeaturesConfig::sectors, 1, 64),
+      integer_key("features.max_edges_per_sector", &Config::features,
+                  &FeaturesConfig::max_edges_per_sector, 0, 10000),
+      integer_key("features.max_surfaces_per_sector", &Config::features,
+                  &FeaturesConfig::max_surfaces_per_sector, 0, 10000),
+      number_key("features.edge_threshold", &Config::features, &FeaturesConfig::edge_threshold,
+                 {0.0, 1.0, true}),
+      number_key("features.max_edge_threshold", &Config::features,
+                 &FeaturesConfig::max_edge_threshold, {0.0, 1.0, true}),
+      number_key("features.surface_threshold", &Config::features,
+                 &FeaturesConfig::surface_threshold, {0.0, 1.0, true}),
+      number_key("features.min_range", &Config::features, &FeaturesConfig::min_range_m,
+                 {0.0, 1000.0}),
+      number_key("features.max_range", &Config::features, &FeaturesConfig::max_range_m,
+                 {0.0, 10000.0, true}),
+      number_key("features.occlusion_jump", &Config::features, &FeaturesConfig::occlusion_jump_m,
+                 {0.0, 100.0, true}),
+      number_key("features.parallel_gap_ratio", &Config::features,
+                 &FeaturesConfig::parallel_gap_ratio, {1.0, 1000.0}),
+      number_key("features.intensity_percentile", &Config::features,
+                 &FeaturesConfig::intensity_percentile, {0.0, 25.0}),
+      number_key("features.intensity_blur_sigma", &Config::features,
+                 &FeaturesConfig::intensity_blur_sigma, {0.0, 10.0}),
+      number_key("features.intensity_bilateral_sigma_color", &Config::features,
+                 &FeaturesConfig::intensity_bilateral_sigma_color, {0.0, 255.0}),
+      number_key("features.intensity_bilateral_sigma_space", &Config::features,
+                 &FeaturesConfig::intensity_bilateral_sigma_space, {0.0, 10.0}),
+      number_key("features.intensity_edge_fraction", &Config::features,
+                 &FeaturesConfig::intensity_edge_fraction, {0.0, 1.0, true}),
+      number_key("features.intensity_noise_factor", &Config::features,
+                 &FeaturesConfig::intensity_noise_factor, {0.0, 100.0}),
+      integer_key("features.intensity_tolerance_px", &Config::features,
+                  &FeaturesConfig::intensity_tolerance_px, 0, 5),
       integer_key("odometry.optimization_steps", &Config::odometry,
                   &OdometryConfig::optimization_steps, 1, 20),
       bool_key("odometry.intensity_fusion", &Config::odometry, &OdometryConfig::intensity_fusion),
@@ -234,3 +268,14 @@ void validate_relations(const Config& c) {
 }
 
 }  // namespace featsense::config::detail
+  if (c.features.min_range_m >= c.features.max_range_m) {
+    throw ConfigError("features.min_range (" + std::to_string(c.features.min_range_m) +
+                      " m) must be below features.max_range (" +
+                      std::to_string(c.features.max_range_m) + " m)");
+  }
+  if (c.features.surface_threshold >= c.features.edge_threshold ||
+      c.features.edge_threshold >= c.features.max_edge_threshold) {
+    throw ConfigError(
+        "features.surface_threshold < features.edge_threshold < features.max_edge_threshold "
+        "must hold");
+  }

@@ -40,6 +40,32 @@ struct MapConfig {
   Backend backend = Backend::kAuto;
 };
 
+/// The feature front end (slam/features): curvature along each scan line, selection per
+/// sector, the paper's filters and the intensity-image edges. Why each value: default.yaml.
+struct FeaturesConfig {
+  int neighbours = 5;  ///< N: the curvature uses +/- N points along the line
+  int sectors = 6;     ///< sub-regions per scan line, each picking its own features
+  int max_edges_per_sector = 20;
+  int max_surfaces_per_sector = 20;
+  /// Normalised curvature |sum_j (P_j - P_i)|^2 / (sum_j |P_j - P_i|)^2, in [0, 1]: 0 on a
+  /// straight line, cos^2(angle / 2) at a corner of that angle between its two legs.
+  double edge_threshold = 0.1;
+  double max_edge_threshold = 0.9;
+  double surface_threshold = 0.02;
+  double min_range_m = 2.0;
+  double max_range_m = 60.0;
+  double occlusion_jump_m = 0.3;
+  /// Both gaps to the line's neighbours above this many column spacings (range * 2 pi / cols).
+  double parallel_gap_ratio = 5.0;
+  double intensity_percentile = 1.0;  ///< %: the 8-bit image spans [p, 100 - p] percentiles
+  double intensity_blur_sigma = 0.5;  ///< pixels
+  double intensity_bilateral_sigma_color = 30.0;  ///< grey levels
+  double intensity_bilateral_sigma_space = 2.0;   ///< pixels
+  double intensity_edge_fraction = 0.2;           ///< of the largest gradient magnitude
+  double intensity_noise_factor = 3.0;            ///< times the median gradient magnitude
+  int intensity_tolerance_px = 1;
+};
+
 struct OdometryConfig {
   int optimization_steps = 3;
   bool intensity_fusion = true;
@@ -63,6 +89,7 @@ struct Config {
   std::map<std::string, std::string> explicit_keys;
 
   bool is_explicit(const std::string& key) const { return explicit_keys.count(key) != 0; }
+  FeaturesConfig features;
 };
 
 /// The value of one key given on the command line by an option that stands for it, e.g.

@@ -1,0 +1,52 @@
+#pragma once
+/// The features of an organized scan: edge and surface points along each scan line (paper
+/// eq. 1, LOAM's selection and filters), edges optionally confirmed by the intensity image.
+
+#include "featsense/config/config.hpp"
+#include "featsense/slam/feature_set.hpp"
+#include "featsense/slam/scan.hpp"
+
+namespace featsense::slam::features {
+
+/// What the extraction needs, from config::FeaturesConfig (the defaults and their reasons
+/// live there and in config/default.yaml) and odometry.intensity_fusion.
+struct FeatureSettings {
+  int neighbours;  ///< N: curvature from +/- N points along the line
+  int sectors;     ///< sub-regions per line
+  int max_edges_per_sector;
+  int max_surfaces_per_sector;
+  double edge_threshold;      ///< normalised curvature (curvature.hpp), dimensionless
+  double max_edge_threshold;  ///< above: unstable natural edge, no feature
+  double surface_threshold;
+  double min_range_m;
+  double max_range_m;
+  double occlusion_jump_m;
+  double parallel_gap_ratio;  ///< in column spacings (range * 2 pi / cols)
+  bool intensity_fusion;
+  double intensity_percentile;
+  double intensity_blur_sigma;
+  double intensity_bilateral_sigma_color;
+  double intensity_bilateral_sigma_space;
+  double intensity_edge_fraction;
+  double intensity_noise_factor;
+  int intensity_tolerance_px;
+};
+
+FeatureSettings from_config(const config::Config& config);
+
+struct FeatureStats {
+  size_t edges_geometric = 0;  ///< edge points before the intensity fusion
+  size_t edges = 0;            ///< after it
+  size_t surfaces = 0;
+  bool intensity_confirmed = false;
+  double curvature_ms = 0.0;  ///< curvature and the filters
+  double selection_ms = 0.0;
+  double intensity_ms = 0.0;  ///< the intensity image and the fusion
+  double total_ms = 0.0;
+};
+
+/// The scan's features. An empty scan or one without valid points gives an empty set.
+FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
+                            FeatureStats* stats = nullptr);
+
+}  // namespace featsense::slam::features

@@ -1,0 +1,114 @@
+#include "featsense/slam/features/feature_extractor.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <optional>
+
+#include "featsense/slam/features/curvature.hpp"
+#include "featsense/slam/features/feature_filters.hpp"
+#include "featsense/slam/features/feature_selection.hpp"
+#include "featsense/slam/features/intensity_edges.hpp"
+
+namespace featsense::slam::features {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+bool well_formed(const Scan& scan) {
+  return scan.rows > 0 && scan.cols > 0 && scan.xyz.size() == scan.size() &&
+         scan.range_m.size() == scan.size() && scan.valid.size() == scan.size();
+}
+
+}  // namespace
+
+FeatureSettings from_config(const config::Config& config) {
+  const config::FeaturesConfig& f = config.features;
+  FeatureSettings s{};
+  s.neighbours = f.neighbours;
+  s.sectors = f.sectors;
+  s.max_edges_per_sector = f.max_edges_per_sector;
+  s.max_surfaces_per_sector = f.max_surfaces_per_sector;
+  s.edge_threshold = f.edge_threshold;
+  s.max_edge_threshold = f.max_edge_threshold;
+  s.surface_threshold = f.surface_threshold;
+  s.min_range_m = f.min_range_m;
+  s.max_range_m = f.max_range_m;
+  s.occlusion_jump_m = f.occlusion_jump_m;
+  s.parallel_gap_ratio = f.parallel_gap_ratio;
+  s.intensity_fusion = config.odometry.intensity_fusion;
+  s.intensity_percentile = f.intensity_percentile;
+  s.intensity_blur_sigma = f.intensity_blur_sigma;
+  s.intensity_bilateral_sigma_color = f.intensity_bilateral_sigma_color;
+  s.intensity_bilateral_sigma_space = f.intensity_bilateral_sigma_space;
+  s.intensity_edge_fraction = f.intensity_edge_fraction;
+  s.intensity_noise_factor = f.intensity_noise_factor;
+  s.intensity_tolerance_px = f.intensity_tolerance_px;
+  return s;
+}
+
+FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
+                            FeatureStats* stats) {
+  const auto start = Clock::now();
+  FeatureStats local;
+  FeatureSet set;
+  set.sequence = scan.sequence;
+  set.stamp_ns = scan.stamp_ns;
+  if (!well_formed(scan)) {
+    if (stats) *stats = local;
+    return set;
+  }
+
+  auto stage = Clock::now();
+  const std::vector<float> curvature = curvature_image(scan, settings.neighbours);
+  const std::vector<uint8_t> excluded = excluded_cells(scan, settings);
+  local.curvature_ms = ms_since(stage);
+
+  stage = Clock::now();
+  std::vector<LinePicks> lines(static_cast<size_t>(scan.rows));
+  tbb::parallel_for(0, scan.rows, [&](int row) {
+    const size_t at = scan.index(row, 0);
+    lines[static_cast<size_t>(row)] =
+        select_line_features(curvature.data() + at, excluded.data() + at, scan.cols, settings);
+  });
+  local.selection_ms = ms_since(stage);
+
+  stage = Clock::now();
+  std::optional<std::vector<uint8_t>> image_edges;
+  if (settings.intensity_fusion) image_edges = intensity_edges(scan, settings);
+  set.intensity_confirmed = image_edges.has_value();
+  const bool has_times = scan.time_offset_s.size() == scan.size();
+  auto time_of = [&](size_t i) { return has_times ? scan.time_offset_s[i] : 0.0f; };
+  for (int row = 0; row < scan.rows; ++row) {
+    const LinePicks& picks = lines[static_cast<size_t>(row)];
+    local.edges_geometric += picks.edges.size();
+    for (int col : picks.edges) {
+      if (image_edges && !near_edge(*image_edges, scan.rows, scan.cols, row, col,
+                                    settings.intensity_tolerance_px)) {
+        continue;
+      }
+      const size_t i = scan.index(row, col);
+      set.edges.push_back(scan.xyz[i]);
+      set.edge_time_s.push_back(time_of(i));
+    }
+    for (int col : picks.surfaces) {
+      const size_t i = scan.index(row, col);
+      set.surfaces.push_back(scan.xyz[i]);
+      set.surface_time_s.push_back(time_of(i));
+    }
+  }
+  local.intensity_ms = ms_since(stage);
+
+  local.edges = set.edges.size();
+  local.surfaces = set.surfaces.size();
+  local.intensity_confirmed = set.intensity_confirmed;
+  local.total_ms = ms_since(start);
+  if (stats) *stats = local;
+  return set;
+}
+
+}  // namespace featsense::slam::features

@@ -1,0 +1,153 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "featsense/config/config.hpp"
+#include "featsense/slam/features/curvature.hpp"
+#include "featsense/slam/features/feature_extractor.hpp"
+#include "featsense/slam/features/feature_filters.hpp"
+#include "featsense/slam/features/feature_selection.hpp"
+
+namespace featsense::slam::features {
+namespace {
+
+FeatureSettings defaults() { return from_config(config::Config{}); }
+
+/// A scan of one or more rows whose cell (row, col) holds point(row, col).
+Scan line_scan(int rows, int cols, const std::function<Eigen::Vector3f(int, int)>& point) {
+  Scan scan = Scan::allocate(rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const size_t i = scan.index(r, c);
+      scan.xyz[i] = point(r, c);
+      scan.range_m[i] = scan.xyz[i].norm();
+      scan.valid[i] = 1;
+    }
+  }
+  return scan;
+}
+
+TEST(FeaturesCurvature, StraightLineIsZero) {
+  const Scan scan =
+      line_scan(1, 40, [](int, int c) { return Eigen::Vector3f(5.0f, 0.1f * c, 1.0f); });
+  for (int col = 5; col < 35; ++col) {
+    EXPECT_NEAR(raw_curvature(scan, 0, col, 5), 0.0f, 1e-8f) << col;
+    EXPECT_NEAR(normalised_curvature(scan, 0, col, 5), 0.0f, 1e-6f) << col;
+  }
+  EXPECT_TRUE(std::isnan(raw_curvature(scan, 0, 4, 5)));  // neighbourhood leaves the line
+  EXPECT_TRUE(std::isnan(raw_curvature(scan, 0, 35, 5)));
+}
+
+TEST(FeaturesCurvature, RightAngleCornerHasEquationOnesValue) {
+  // Legs along x and y meeting at col 10, spacing d: sum_j (P_j - P_i) = d * N(N+1)/2 * (1, 1).
+  const float d = 0.1f;
+  const Scan scan = line_scan(1, 21, [&](int, int c) {
+    const Eigen::Vector3f corner(5.0f, 5.0f, 0.0f);
+    return c <= 10 ? Eigen::Vector3f(corner + Eigen::Vector3f(d * (10 - c), 0, 0))
+                   : Eigen::Vector3f(corner + Eigen::Vector3f(0, d * (c - 10), 0));
+  });
+  const int n = 5;
+  const float leg = d * n * (n + 1) / 2.0f;
+  EXPECT_NEAR(raw_curvature(scan, 0, 10, n), 2.0f * leg * leg, 1e-5f);
+  EXPECT_NEAR(normalised_curvature(scan, 0, 10, n), 0.5f, 1e-5f);  // cos^2(45 deg)
+  // One cell off the corner the value is smaller but non-zero.
+  EXPECT_GT(raw_curvature(scan, 0, 10, n), raw_curvature(scan, 0, 9, n));
+  EXPECT_GT(raw_curvature(scan, 0, 9, n), 0.0f);
+}
+
+TEST(FeaturesCurvature, NormalisedValueIsTheSameAtAnyRangeAndSpacing) {
+  for (float d : {0.01f, 0.1f, 0.5f}) {
+    const Scan scan = line_scan(1, 21, [&](int, int c) {
+      return c <= 10 ? Eigen::Vector3f(40.0f + d * (10 - c), 0, 0)
+                     : Eigen::Vector3f(40.0f, d * (c - 10), 0);
+    });
+    EXPECT_NEAR(normalised_curvature(scan, 0, 10, 5), 0.5f, 1e-4f) << d;
+  }
+}
+
+TEST(FeaturesCurvature, InvalidCellBreaksTheNeighbourhood) {
+  Scan scan = line_scan(1, 40, [](int, int c) { return Eigen::Vector3f(5.0f, 0.1f * c, 0.0f); });
+  scan.invalidate(scan.index(0, 20));
+  for (int col = 15; col <= 25; ++col) EXPECT_TRUE(std::isnan(raw_curvature(scan, 0, col, 5)));
+  EXPECT_FALSE(std::isnan(raw_curvature(scan, 0, 14, 5)));
+  EXPECT_FALSE(std::isnan(raw_curvature(scan, 0, 26, 5)));
+}
+
+TEST(FeaturesSelection, LimitsPerSectorAndNeighbourExclusion) {
+  FeatureSettings s = defaults();
+  s.sectors = 2;
+  s.max_edges_per_sector = 3;
+  s.max_surfaces_per_sector = 4;
+  const int cols = 210;
+  std::vector<float> curvature(cols, 0.0f);
+  for (int c = 0; c < s.neighbours; ++c) curvature[c] = curvature[cols - 1 - c] = NAN;
+  // Every column an edge candidate of falling curvature: picks must be >= N + 1 apart.
+  for (int c = 5; c < 105; ++c) curvature[c] = 0.5f - 0.001f * c;
+  const std::vector<uint8_t> excluded(cols, 0);
+  const LinePicks picks = select_line_features(curvature.data(), excluded.data(), cols, s);
+  ASSERT_EQ(picks.edges.size(), 3u);  // the first sector's limit; the second has no candidates
+  EXPECT_EQ(picks.edges[0], 5);
+  for (size_t k = 1; k < picks.edges.size(); ++k) {
+    EXPECT_GT(picks.edges[k] - picks.edges[k - 1], s.neighbours);
+  }
+  // Surfaces: zero curvature in the second sector, at most 4 there, spread out too.
+  int second = 0;
+  for (int col : picks.surfaces) {
+    if (col >= 105) ++second;
+  }
+  EXPECT_EQ(second, 4);
+  std::vector<int> all = picks.edges;
+  all.insert(all.end(), picks.surfaces.begin(), picks.surfaces.end());
+  for (size_t a = 0; a < all.size(); ++a) {
+    for (size_t b = a + 1; b < all.size(); ++b) EXPECT_GT(std::abs(all[a] - all[b]), s.neighbours);
+  }
+  // Above the maximum: no edge; excluded cells: nothing.
+  std::vector<float> spiky(cols, 0.95f);
+  for (int c = 0; c < s.neighbours; ++c) spiky[c] = spiky[cols - 1 - c] = NAN;
+  EXPECT_TRUE(select_line_features(spiky.data(), excluded.data(), cols, s).edges.empty());
+  const std::vector<uint8_t> all_excluded(cols, 1);
+  const LinePicks none = select_line_features(curvature.data(), all_excluded.data(), cols, s);
+  EXPECT_TRUE(none.edges.empty());
+  EXPECT_TRUE(none.surfaces.empty());
+}
+
+TEST(FeaturesFilters, SurfaceParallelToTheBeamIsExcluded) {
+  FeatureSettings s = defaults();
+  s.occlusion_jump_m = 100.0;  // the range grows fast along the wall: test this filter alone
+  const int cols = 360;
+  // A wall at x = 5 seen across 60 columns: near the beam's foot (col 0) the gaps are about
+  // one column spacing; at grazing columns (incidence > 80 deg) they are many.
+  const Scan scan = line_scan(1, cols, [&](int, int c) {
+    const double a = 2.0 * M_PI * c / cols;
+    const double angle = std::min(a, 1.45);  // beyond that the points crowd at the far end
+    return Eigen::Vector3f(5.0f, static_cast<float>(5.0 * std::tan(angle)) + 0.001f * c, 0.0f);
+  });
+  const std::vector<uint8_t> excluded = excluded_cells(scan, s);
+  EXPECT_EQ(excluded[10], 0);  // 10 deg incidence, 9 m range: fine
+  EXPECT_EQ(excluded[45], 0);  // 45 deg
+  EXPECT_EQ(excluded[82], 1);  // 82 deg: gaps 7 times the column spacing
+}
+
+TEST(FeaturesFilters, FarSideOfAnOcclusionIsExcluded) {
+  const FeatureSettings s = defaults();
+  // A wall at 10 m with a pole at 5 m covering columns 30..39.
+  const Scan scan = line_scan(1, 80, [](int, int c) {
+    const float x = (c >= 30 && c < 40) ? 5.0f : 10.0f;
+    return Eigen::Vector3f(x, x * 0.005f * (c - 40), 0.0f);
+  });
+  const std::vector<uint8_t> excluded = excluded_cells(scan, s);
+  for (int c = 24; c <= 29; ++c) EXPECT_EQ(excluded[c], 1) << c;  // far side, left
+  for (int c = 40; c <= 45; ++c) EXPECT_EQ(excluded[c], 1) << c;  // far side, right
+  for (int c = 30; c < 40; ++c) EXPECT_EQ(excluded[c], 0) << c;   // the pole itself
+  EXPECT_EQ(excluded[15], 0);
+  EXPECT_EQ(excluded[60], 0);
+  // Range limits.
+  FeatureSettings near = s;
+  near.max_range_m = 8.0;
+  EXPECT_EQ(excluded_cells(scan, near)[60], 1);
+  EXPECT_EQ(excluded_cells(scan, near)[35], 0);
+}
+
+}  // namespace
+}  // namespace featsense::slam::features
