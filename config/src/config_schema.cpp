@@ -219,6 +219,22 @@ std::vector<KeySpec> make_specs() {
                   &OdometryConfig::optimization_steps, 1, 20),
       bool_key("odometry.intensity_fusion", &Config::odometry, &OdometryConfig::intensity_fusion),
       bool_key("odometry.deskew", &Config::odometry, &OdometryConfig::deskew),
+      number_key("odometry.edge_voxel", &Config::odometry, &OdometryConfig::edge_voxel_m,
+                 {0.0, 10.0, true}),
+      number_key("odometry.surface_voxel", &Config::odometry, &OdometryConfig::surface_voxel_m,
+                 {0.0, 10.0, true}),
+      number_key("odometry.map_radius", &Config::odometry, &OdometryConfig::map_radius_m,
+                 {1.0, 10000.0}),
+      number_key("odometry.max_correspondence_distance", &Config::odometry,
+                 &OdometryConfig::max_correspondence_distance_m, {0.0, 100.0, true}),
+      number_key("odometry.huber_loss", &Config::odometry, &OdometryConfig::huber_loss_m,
+                 {0.0, 100.0, true}),
+      number_key("odometry.degeneracy_threshold", &Config::odometry,
+                 &OdometryConfig::degeneracy_threshold, {0.0, 1.0}),
+      number_key("odometry.max_speed", &Config::odometry, &OdometryConfig::max_speed_m_s,
+                 {0.0, 1000.0, true}),
+      number_key("odometry.max_turn_rate", &Config::odometry, &OdometryConfig::max_turn_rate_rad_s,
+                 {0.0, 100.0, true}),
       bool_key("refine.enabled", &Config::refine, &RefineConfig::enabled),
       number_key("refine.distance", &Config::refine, &RefineConfig::distance_m,
                  {0.0, 10000.0, true}),
@@ -259,15 +275,6 @@ void validate_relations(const Config& c) {
       << " voxels, more than the 2^31 a local map may hold; use a smaller map or larger voxels";
     throw ConfigError(s.str());
   }
-  const double half_smallest = 0.5 * std::min(c.map.size_m[0], c.map.size_m[1]);
-  if (c.map.shift_threshold_m > half_smallest) {
-    throw ConfigError("map.shift_threshold (" + std::to_string(c.map.shift_threshold_m) +
-                      " m) must be at most half the smallest horizontal extent of map.size (" +
-                      std::to_string(half_smallest) + " m)");
-  }
-}
-
-}  // namespace featsense::config::detail
   if (c.features.min_range_m >= c.features.max_range_m) {
     throw ConfigError("features.min_range (" + std::to_string(c.features.min_range_m) +
                       " m) must be below features.max_range (" +
@@ -279,3 +286,12 @@ void validate_relations(const Config& c) {
         "features.surface_threshold < features.edge_threshold < features.max_edge_threshold "
         "must hold");
   }
+  const double half_smallest = 0.5 * std::min(c.map.size_m[0], c.map.size_m[1]);
+  if (c.map.shift_threshold_m > half_smallest) {
+    throw ConfigError("map.shift_threshold (" + std::to_string(c.map.shift_threshold_m) +
+                      " m) must be at most half the smallest horizontal extent of map.size (" +
+                      std::to_string(half_smallest) + " m)");
+  }
+}
+
+}  // namespace featsense::config::detail

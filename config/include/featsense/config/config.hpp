@@ -70,6 +70,15 @@ struct OdometryConfig {
   int optimization_steps = 3;
   bool intensity_fusion = true;
   bool deskew = true;
+  // Registration (slam/odometry). Why each value: default.yaml.
+  double edge_voxel_m = 0.4;     ///< voxel of the local edge map and of each scan's edges
+  double surface_voxel_m = 0.8;  ///< voxel of the local surface map and of the scan's surfaces
+  double map_radius_m = 50.0;    ///< map points farther than this from the sensor are dropped
+  double max_correspondence_distance_m = 1.0;  ///< the 5 neighbours lie within this
+  double huber_loss_m = 0.1;                   ///< residuals beyond this count linearly
+  double degeneracy_threshold = 0.02;          ///< see default.yaml
+  double max_speed_m_s = 30.0;  ///< larger corrections of the prediction are divergence
+  double max_turn_rate_rad_s = 3.0;
 };
 
 struct RefineConfig {
@@ -80,6 +89,7 @@ struct RefineConfig {
 struct Config {
   SensorConfig sensor;
   MapConfig map;
+  FeaturesConfig features;
   OdometryConfig odometry;
   RefineConfig refine;
   /// The keys given a value explicitly (by the YAML file, a --set or a command-line option
@@ -89,7 +99,6 @@ struct Config {
   std::map<std::string, std::string> explicit_keys;
 
   bool is_explicit(const std::string& key) const { return explicit_keys.count(key) != 0; }
-  FeaturesConfig features;
 };
 
 /// The value of one key given on the command line by an option that stands for it, e.g.

@@ -1,0 +1,44 @@
+#pragma once
+/// F-LOAM-style odometry: each scan's features registered against the local feature map,
+/// from a constant-velocity prediction. Not thread-safe: one scan at a time, in order.
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <memory>
+
+#include "featsense/slam/feature_set.hpp"
+#include "featsense/slam/odometry/odometry_result.hpp"
+#include "featsense/slam/odometry/odometry_settings.hpp"
+
+namespace featsense::slam::odometry {
+
+class LocalFeatureMap;
+
+class FeatureOdometry {
+ public:
+  explicit FeatureOdometry(const OdometrySettings& settings);
+  ~FeatureOdometry();
+  FeatureOdometry(const FeatureOdometry&) = delete;
+  FeatureOdometry& operator=(const FeatureOdometry&) = delete;
+
+  /// Registers one scan: its pose at the stamp, never NaN. The first scan starts the map at
+  /// the identity. An empty scan, too few correspondences or a diverging solve (a correction
+  /// of the prediction beyond max_speed / max_turn_rate over the elapsed time, or a cost
+  /// above the prediction's) give the prediction, with converged=false and the reason.
+  /// In degenerate directions the pose keeps the prediction. Every scan with features is
+  /// then added to the map at the pose given.
+  OdometryResult register_scan(const FeatureSet& features);
+
+ private:
+  OdometrySettings settings_;
+  std::unique_ptr<LocalFeatureMap> map_;
+  bool started_ = false;
+  int64_t last_stamp_ns_ = 0;
+  Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
+  /// The last motion (previous <- current) and the time it took, for the prediction.
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
+  double last_motion_s_ = 0.0;
+};
+
+}  // namespace featsense::slam::odometry

@@ -1,0 +1,44 @@
+#pragma once
+/// What the registration of one scan gives: the pose, the motion since the last scan and
+/// how it was found.
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "featsense/slam/scan_locator.hpp"
+
+namespace featsense::slam::odometry {
+
+struct OdometryResult {
+  /// The sensor's pose at the scan's stamp (map <- sensor). Never NaN: where the solve
+  /// cannot be trusted it is the constant-velocity prediction.
+  Eigen::Isometry3d T_map_sensor = Eigen::Isometry3d::Identity();
+  /// The motion since the previous scan (previous sensor <- this sensor); identity for the
+  /// first scan. The motion within the scan (deskewing) is not estimated here yet.
+  Eigen::Isometry3d T_previous_sensor = Eigen::Isometry3d::Identity();
+  double elapsed_s = 0.0;  ///< time since the previous scan (0 for the first)
+
+  /// converged, iterations (Ceres iterations in all), degenerate, fitness_m (mean
+  /// point-to-line / point-to-plane distance of the correspondences at the result).
+  LocateDiagnostics diagnostics;
+  /// Why the result is not converged, degenerate, or the first scan; empty otherwise.
+  std::string reason;
+  /// The unobservable directions, unit 6-vectors in the pose's tangent [rotation (rad, in
+  /// the map frame, about the sensor), translation (m, map frame)]: the pose keeps the
+  /// prediction along them.
+  std::vector<Eigen::Matrix<double, 6, 1>> degenerate_directions;
+  /// The eigenvalues of J^T J / N at the result, ascending (see degeneracy_threshold).
+  Eigen::Matrix<double, 6, 1> information_eigenvalues = Eigen::Matrix<double, 6, 1>::Zero();
+
+  size_t scan_edges = 0;               ///< the scan's edges after the voxel filter
+  size_t scan_surfaces = 0;            ///< the scan's surfaces after the voxel filter
+  size_t edge_correspondences = 0;     ///< in the last outer loop
+  size_t surface_correspondences = 0;  ///< in the last outer loop
+  size_t map_edges = 0;                ///< the local map after this scan was added
+  size_t map_surfaces = 0;
+};
+
+}  // namespace featsense::slam::odometry

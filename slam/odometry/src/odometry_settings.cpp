@@ -1,0 +1,21 @@
+#include "featsense/slam/odometry/odometry_settings.hpp"
+
+namespace featsense::slam::odometry {
+
+OdometrySettings from_config(const config::Config& config) {
+  const config::OdometryConfig& c = config.odometry;
+  OdometrySettings s;
+  s.optimization_steps = c.optimization_steps;
+  s.solver_iterations = 4;
+  s.edge_voxel_m = c.edge_voxel_m;
+  s.surface_voxel_m = c.surface_voxel_m;
+  s.map_radius_m = c.map_radius_m;
+  s.max_correspondence_distance_m = c.max_correspondence_distance_m;
+  s.huber_loss_m = c.huber_loss_m;
+  s.degeneracy_threshold = c.degeneracy_threshold;
+  s.max_speed_m_s = c.max_speed_m_s;
+  s.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
+  return s;
+}
+
+}  // namespace featsense::slam::odometry
