@@ -250,6 +250,7 @@ TEST(OdometrySpeed, MedianRegistrationTime) {
   Eigen::Isometry3d truth = pose(0, 0, 0, {-8, 0, 1.5});
   std::vector<double> ms;
   size_t surfaces = 0, edges = 0;
+  OdometryResult last;
   for (int i = 0; i < 30; ++i) {
     const FeatureSet f = observe(hall, truth, i * kFrame);
     surfaces = f.surfaces.size();
@@ -261,11 +262,15 @@ TEST(OdometrySpeed, MedianRegistrationTime) {
     if (i > 0) {
       EXPECT_TRUE(r.diagnostics.converged) << i << ": " << r.reason;
     }
+    last = r;
     truth = truth * step;
   }
   std::nth_element(ms.begin(), ms.begin() + static_cast<long>(ms.size() / 2), ms.end());
-  std::printf("register_scan: median %.2f ms over %zu scans (%zu surface, %zu edge points)\n",
-              ms[ms.size() / 2], ms.size(), surfaces, edges);
+  std::printf(
+      "register_scan: median %.2f ms over %zu scans (%zu surface, %zu edge points; %zu / %zu after "
+      "the voxel filter; %zu / %zu correspondences; map %zu / %zu)\n",
+      ms[ms.size() / 2], ms.size(), surfaces, edges, last.scan_surfaces, last.scan_edges,
+      last.surface_correspondences, last.edge_correspondences, last.map_surfaces, last.map_edges);
 }
 
 }  // namespace

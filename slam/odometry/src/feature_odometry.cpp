@@ -1,9 +1,12 @@
 #include "featsense/slam/odometry/feature_odometry.hpp"
 
 #include <ceres/ceres.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,22 +45,50 @@ struct Correspondences {
   size_t size() const { return lines.size() + planes.size(); }
 };
 
+/// The correspondences of `points` at pose T: `search` gives a map point's neighbours, `make`
+/// the residual of a fitted line or plane (or nothing).
+template <class Residual, class Search, class Make>
+std::vector<Residual> match(const std::vector<Eigen::Vector3f>& points, const Eigen::Isometry3d& T,
+                            Search&& search, Make&& make) {
+  // The nearest-neighbour searches dominate: both cores share them, the order stays the scan's.
+  std::vector<std::optional<Residual>> found(points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i < range.end(); ++i) {
+                        const Eigen::Vector3d p = points[i].cast<double>();
+                        const std::vector<Eigen::Vector3d> near = search(T * p);
+                        if (near.size() == static_cast<size_t>(kNeighbours))
+                          found[i] = make(p, near);
+                      }
+                    });
+  std::vector<Residual> out;
+  for (const auto& f : found) {
+    if (f) out.push_back(*f);
+  }
+  return out;
+}
+
 Correspondences associate(const LocalFeatureMap& map, const std::vector<Eigen::Vector3f>& edges,
                           const std::vector<Eigen::Vector3f>& surfaces, const Eigen::Isometry3d& T,
                           double max_distance) {
   Correspondences c;
-  for (const Eigen::Vector3f& e : edges) {
-    const Eigen::Vector3d p = e.cast<double>();
-    const auto near = map.nearest_edges(T * p, kNeighbours, max_distance);
-    if (near.size() < static_cast<size_t>(kNeighbours)) continue;
-    if (const auto line = fit_line(near)) c.lines.push_back({p, line->point, line->direction});
-  }
-  for (const Eigen::Vector3f& s : surfaces) {
-    const Eigen::Vector3d p = s.cast<double>();
-    const auto near = map.nearest_surfaces(T * p, kNeighbours, max_distance);
-    if (near.size() < static_cast<size_t>(kNeighbours)) continue;
-    if (const auto plane = fit_plane(near)) c.planes.push_back({p, plane->normal, plane->offset});
-  }
+  c.lines = match<PointToLine>(
+      edges, T,
+      [&](const Eigen::Vector3d& x) { return map.nearest_edges(x, kNeighbours, max_distance); },
+      [](const Eigen::Vector3d& p,
+         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToLine> {
+        if (const auto line = fit_line(near)) return PointToLine{p, line->point, line->direction};
+        return std::nullopt;
+      });
+  c.planes = match<PointToPlane>(
+      surfaces, T,
+      [&](const Eigen::Vector3d& x) { return map.nearest_surfaces(x, kNeighbours, max_distance); },
+      [](const Eigen::Vector3d& p,
+         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
+        if (const auto plane = fit_plane(near))
+          return PointToPlane{p, plane->normal, plane->offset};
+        return std::nullopt;
+      });
   return c;
 }
 
