@@ -11,9 +11,12 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "eval_json.hpp"
 #include "featsense/config/config_error.hpp"
+#include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "featsense/tsdf/integrator.hpp"
 #include "json_output.hpp"
 #include "map_job.hpp"
@@ -64,6 +67,27 @@ slam::Trajectory read_poses(const MapOptions& options) {
   return slam::read_trajectory(*options.gt, options.gt_format, options.gt_times);
 }
 
+/// The ground truth of a simulated recording (gt_trajectory.tum in its folder), if any.
+std::optional<slam::Trajectory> ground_truth_beside(const slam::SourceInfo& info) {
+  const fs::path file = fs::path(info.path) / "gt_trajectory.tum";
+  if (!fs::is_directory(info.path) || !fs::is_regular_file(file)) return std::nullopt;
+  try {
+    return slam::read_tum(file.string());
+  } catch (const slam::TrajectoryError& e) {
+    spdlog::warn("ignoring the ground truth beside the recording: {}", e.what());
+    return std::nullopt;
+  }
+}
+
+nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts) {
+  return {{"scans", counts.scans},
+          {"degenerate_scans", counts.degenerate_scans},
+          {"failed_scans", counts.failed_scans},
+          {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
+          {"features_per_scan",
+           counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0}};
+}
+
 tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
   const Eigen::Vector3d t = pose.translation();
   return {static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())};
@@ -79,24 +103,31 @@ config::Config map_config(const MapOptions& options, const CliContext& context) 
 
 MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   config::Config config = map_config(options, context);
-  if (!options.gt) {
-    throw config::ConfigError(
-        "featsense map needs the sensor's poses: pass --gt TRAJ (a TUM file, or KITTI poses with "
-        "one pose per scan); this version has no odometry front end to estimate them");
-  }
   frame_range(options);  // bad --start / --end fail before the recording is opened
+  std::optional<slam::Trajectory> poses;
+  if (options.gt) poses = read_poses(options);
   std::unique_ptr<slam::ScanSource> source = options.input.open(config);
-  return map_recording(*source, read_poses(options), options, config,
+  return map_recording(*source, std::move(poses), options, config,
                        find_mesh_references(options.input.input, options.reference), context);
 }
 
-MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
+MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const MapOptions& options, config::Config config,
                          const MeshReferences& references, const CliContext& context) {
   const FrameRange range = frame_range(options);
   const slam::SourceInfo& info = source.info();
-  std::unique_ptr<slam::ScanLocator> locator =
-      slam::make_given_pose_locator(std::move(poses), config.odometry.deskew);
+  // Without given poses, a simulated recording's ground truth (beside its scans) fixes the
+  // map frame at its first pose, so that the map and the path can be compared with the truth.
+  const std::optional<slam::Trajectory> truth = poses ? std::nullopt : ground_truth_beside(info);
+  std::unique_ptr<slam::odometry::OdometryLocator> odometry;
+  std::unique_ptr<slam::ScanLocator> given;
+  if (poses) {
+    given = slam::make_given_pose_locator(std::move(*poses), config.odometry.deskew);
+  } else {
+    odometry = slam::odometry::make_odometry_locator(
+        config, truth && !truth->empty() ? truth->poses.front() : Eigen::Isometry3d::Identity());
+  }
+  slam::ScanLocator* locator = given ? given.get() : odometry.get();
 
   const fs::path out(options.output);
   fs::create_directories(out);
@@ -170,6 +201,16 @@ MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
     summary.device_memory_bytes = integrator->memory_bytes();
   }
   nlohmann::json report = map_report_json(summary);
+  if (odometry) report["odometry"] = odometry_json(odometry->counts());
+  if (truth && result.poses.size() >= 2) {
+    try {
+      const slam::TrajectoryEvaluationSettings eval_settings;
+      report["eval"]["traj"] = trajectory_evaluation_json(
+          slam::evaluate_trajectory(result.poses, *truth, eval_settings), eval_settings);
+    } catch (const slam::TrajectoryError& e) {
+      spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
+    }
+  }
   if (!options.no_mesh && result.frames_mapped > 0) {
     const MapMesh meshed = mesh_map(out / "map.h5", out);
     report["mesh"] = mesh_json(meshed);

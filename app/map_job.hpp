@@ -36,17 +36,19 @@ struct MapOutcome {
   nlohmann::json report;  ///< as written to report.json
 };
 
-/// Maps INPUT (opened with the run's configuration) with the poses of --gt into OUT.
+/// Maps INPUT (opened with the run's configuration) into OUT, with the poses of --gt or,
+/// without it, poses estimated by the odometry.
 MapOutcome run_map(const MapOptions& options, const CliContext& context);
 
 /// The run's configuration (defaults, --config, --set) with --backend applied. Throws
 /// ConfigError.
 config::Config map_config(const MapOptions& options, const CliContext& context);
 
-/// Maps `source` with `poses` and `config` (from map_config) into OUT (map.h5,
-/// trajectory.tum/.kitti, mesh.ply/.glb, report.json). Throws ConfigError, InputError, Interrupted
+/// Maps `source` with `poses` (given poses; nullopt: estimated by the odometry front end) and
+/// `config` (from map_config) into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb,
+/// report.json). Throws ConfigError, InputError, Interrupted
 /// (after writing the outputs) or std::runtime_error.
-MapOutcome map_recording(slam::ScanSource& source, slam::Trajectory poses,
+MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const MapOptions& options, config::Config config,
                          const MeshReferences& references, const CliContext& context);
 

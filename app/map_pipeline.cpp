@@ -95,6 +95,9 @@ void locate_scans(slam::ScanLocator& locator, bool drop_mixed, BoundedQueue<slam
       state.warn("skipped: " + why, result);
       continue;
     }
+    // A placement that comes with a reason is a pose the front end could not trust (e.g.
+    // the odometry's prediction): counted and kept.
+    if (!why.empty()) state.warn(why, result);
     LocatedScan located;
     located.rays = scan_to_rays(*scan, *placement);
     located.placement = std::move(*placement);

@@ -1,0 +1,37 @@
+#pragma once
+/// The front end's stage with estimated poses: each scan's features extracted
+/// (slam/features), registered against the local feature map (FeatureOdometry), and the scan
+/// placed with the motion over it, so that the map integrates it deskewed.
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <memory>
+
+#include "featsense/config/config.hpp"
+#include "featsense/slam/scan_locator.hpp"
+
+namespace featsense::slam::odometry {
+
+/// What the odometry has done so far, for the log and the report.
+struct OdometryCounts {
+  size_t scans = 0;
+  size_t degenerate_scans = 0;  ///< a direction of motion held at the prediction
+  size_t failed_scans = 0;      ///< the pose is the prediction (the reason is logged)
+  size_t intensity_confirmed_scans = 0;
+  double features_sum = 0.0;  ///< edge + surface points, summed over scans
+};
+
+class OdometryLocator : public ScanLocator {
+ public:
+  /// Counts of the run so far (read after the pipeline has joined its threads).
+  virtual OdometryCounts counts() const = 0;
+};
+
+/// Features and registration as `config` says (features.*, odometry.*). The first scan is
+/// placed at `T_map_first` (map <- sensor; the identity: the first scan defines the map frame).
+std::unique_ptr<OdometryLocator> make_odometry_locator(
+    const config::Config& config,
+    const Eigen::Isometry3d& T_map_first = Eigen::Isometry3d::Identity());
+
+}  // namespace featsense::slam::odometry

@@ -1,0 +1,112 @@
+#include "featsense/slam/odometry/odometry_locator.hpp"
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/slam/features/feature_extractor.hpp"
+#include "featsense/slam/odometry/feature_odometry.hpp"
+
+namespace featsense::slam::odometry {
+namespace {
+
+/// The fraction `s` of a rigid motion at constant velocity: rotation by slerp from the
+/// identity, translation in proportion (the two decoupled, as the pose interpolation of
+/// given trajectories does).
+Eigen::Isometry3d part_of(const Eigen::Isometry3d& motion, double s) {
+  const Eigen::Quaterniond q(motion.linear());
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond::Identity().slerp(s, q).normalized().toRotationMatrix();
+  out.translation() = s * motion.translation();
+  return out;
+}
+
+/// The mean of `times` (seconds after the stamp), 0 when empty.
+double mean_time(const std::vector<float>& edges, const std::vector<float>& surfaces) {
+  double sum = 0.0;
+  for (const float t : edges) sum += static_cast<double>(t);
+  for (const float t : surfaces) sum += static_cast<double>(t);
+  const size_t n = edges.size() + surfaces.size();
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
+class FeatureOdometryLocator final : public OdometryLocator {
+ public:
+  FeatureOdometryLocator(features::FeatureSettings features, const OdometrySettings& odometry,
+                         bool deskew, const Eigen::Isometry3d& T_map_first)
+      : features_(features), odometry_(odometry), deskew_(deskew), T_map_first_(T_map_first) {}
+
+  std::optional<ScanPlacement> locate(const Scan& scan, std::string& why) override {
+    const FeatureSet found = features::extract_features(scan, features_);
+    // The features are registered as measured, over the whole sweep: the pose that fits them
+    // best is the sensor's pose at about their mean time, and every scan's features enter the
+    // feature map the same way, so the poses agree with each other. (Deskewing the features
+    // with the last motion before registration fed each motion error into the next scan's
+    // estimate and made it oscillate.) The pose at the stamp and the motion over the scan
+    // then follow from the motion estimated between the scans.
+    const OdometryResult result = odometry_.register_scan(found);
+    ++counts_.scans;
+    counts_.features_sum += static_cast<double>(found.size());
+    if (found.intensity_confirmed) ++counts_.intensity_confirmed_scans;
+    if (result.diagnostics.degenerate) ++counts_.degenerate_scans;
+    if (!result.diagnostics.converged && counts_.scans > 1) {
+      ++counts_.failed_scans;
+      why = "scan " + std::to_string(scan.sequence) + " not registered (" + result.reason +
+            "): the pose is the prediction";
+    }
+    if (result.elapsed_s > 0.0) {
+      last_motion_ = result.T_previous_sensor;
+      last_period_s_ = result.elapsed_s;
+    }
+    const bool moving = last_period_s_ > 0.0;
+    const double fit_time_s = mean_time(found.edge_time_s, found.surface_time_s);
+
+    ScanPlacement placed;
+    placed.sequence = scan.sequence;
+    placed.stamp_ns = scan.stamp_ns;
+    placed.T_map_sensor = T_map_first_ * result.T_map_sensor;
+    if (moving)
+      placed.T_map_sensor =
+          placed.T_map_sensor * part_of(last_motion_, -fit_time_s / last_period_s_);
+    placed.diagnostics = result.diagnostics;
+    if (deskew_ && moving) {
+      placed.column_T_map_sensor.assign(static_cast<size_t>(scan.cols), placed.T_map_sensor);
+      const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
+      for (size_t col = 0; col < times.size(); ++col) {
+        if (!times[col]) continue;
+        const double s = static_cast<double>(*times[col]) / last_period_s_;
+        placed.column_T_map_sensor[col] = placed.T_map_sensor * part_of(last_motion_, s);
+      }
+    }
+    return placed;
+  }
+
+  std::string description() const override {
+    return std::string("odometry (features") +
+           (features_.intensity_fusion ? " with intensity edges" : "") +
+           ", point-to-line / point-to-plane registration" +
+           (deskew_ ? ", scans deskewed for the map)" : ")");
+  }
+
+  OdometryCounts counts() const override { return counts_; }
+
+ private:
+  features::FeatureSettings features_;
+  FeatureOdometry odometry_;
+  bool deskew_;
+  Eigen::Isometry3d T_map_first_;
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
+  double last_period_s_ = 0.0;
+  OdometryCounts counts_;
+};
+
+}  // namespace
+
+std::unique_ptr<OdometryLocator> make_odometry_locator(const config::Config& config,
+                                                       const Eigen::Isometry3d& T_map_first) {
+  return std::make_unique<FeatureOdometryLocator>(
+      features::from_config(config), from_config(config), config.odometry.deskew, T_map_first);
+}
+
+}  // namespace featsense::slam::odometry
