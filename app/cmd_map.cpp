@@ -1,5 +1,5 @@
-// featsense map INPUT -o OUT --gt TRAJ: a recording and its poses in; the map (map.h5), the
-// poses used (trajectory.tum / .kitti) and report.json out.
+// featsense map INPUT -o OUT [--gt TRAJ]: a recording (and its poses, else the odometry's)
+// in; the map (map.h5), the poses used (trajectory.tum / .kitti) and report.json out.
 
 #include <spdlog/spdlog.h>
 
@@ -243,12 +243,13 @@ Command register_map(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<MapOptions>();
   CLI::App* command = app.add_subcommand(
       "map",
-      "Map a recording with given poses: the TSDF map (map.h5), the poses used and a report");
+      "Map a recording: the TSDF map (map.h5), the poses (given by --gt, else estimated by the "
+      "odometry) and a report");
   options->input.add_to(*command, false);
   command->add_option("-o,--output", options->output, "Output folder")->required();
   command->add_option("--gt", options->gt,
                       "The sensor's poses: TUM (interpolated to each scan's and column's time) or "
-                      "KITTI (one pose per scan)");
+                      "KITTI (one pose per scan); without it the odometry estimates them");
   command->add_option("--gt-format", options->gt_format, "Format of --gt: auto, tum or kitti")
       ->check(CLI::IsMember({"auto", "tum", "kitti"}));
   command->add_option("--gt-times", options->gt_times, "Times file of KITTI poses (times.txt)")
