@@ -135,6 +135,15 @@ TEST(OdometryVoxelFilter, OnePointPerVoxelAndNoNaN) {
   EXPECT_EQ(kept[0], points[0]);
   EXPECT_EQ(kept[1], points[2]);
   EXPECT_EQ(kept[2], points[4]);
+
+  // The timed variant keeps each kept point's own time, and 0 where no times are given.
+  const std::vector<float> times = {0.01f, 0.02f, 0.03f, 0.04f, 0.05f};
+  std::vector<float> kept_times;
+  const auto timed = voxel_filter(points, times, 0.4, &kept_times);
+  ASSERT_EQ(timed, kept);
+  EXPECT_EQ(kept_times, (std::vector<float>{0.01f, 0.03f, 0.05f}));
+  voxel_filter(points, {}, 0.4, &kept_times);
+  EXPECT_EQ(kept_times, (std::vector<float>{0.0f, 0.0f, 0.0f}));
 }
 
 }  // namespace

@@ -181,9 +181,16 @@ FeatureOdometry::~FeatureOdometry() = default;
 
 OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
   OdometryResult result;
-  const std::vector<Eigen::Vector3f> edges = voxel_filter(features.edges, settings_.edge_voxel_m);
-  const std::vector<Eigen::Vector3f> surfaces =
-      voxel_filter(features.surfaces, settings_.surface_voxel_m);
+  std::vector<float> edge_times;
+  std::vector<float> surface_times;
+  const std::vector<Eigen::Vector3f> raw_edges =
+      voxel_filter(features.edges, features.edge_time_s, settings_.edge_voxel_m, &edge_times);
+  const std::vector<Eigen::Vector3f> raw_surfaces = voxel_filter(
+      features.surfaces, features.surface_time_s, settings_.surface_voxel_m, &surface_times);
+  // The points in the sensor frame at the stamp: each moved by the part of the motion since
+  // the last scan that the sensor had made when it was measured (constant velocity).
+  std::vector<Eigen::Vector3f> edges = raw_edges;
+  std::vector<Eigen::Vector3f> surfaces = raw_surfaces;
   result.scan_edges = edges.size();
   result.scan_surfaces = surfaces.size();
 
@@ -197,8 +204,22 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
     if (!finite(prediction)) prediction = last_pose_;
   }
   Eigen::Isometry3d pose = prediction;
+  const auto deskew_for = [&](const Eigen::Isometry3d& T) {
+    if (!settings_.deskew || !started_ || !(result.elapsed_s > 0.0)) return;
+    const Eigen::Isometry3d motion = last_pose_.inverse() * T;
+    const auto apply = [&](const std::vector<Eigen::Vector3f>& raw, const std::vector<float>& times,
+                           std::vector<Eigen::Vector3f>& out) {
+      for (size_t i = 0; i < raw.size(); ++i) {
+        const double s = static_cast<double>(times[i]) / result.elapsed_s;
+        out[i] = (scaled(motion, s) * raw[i].cast<double>()).cast<float>();
+      }
+    };
+    apply(raw_edges, edge_times, edges);
+    apply(raw_surfaces, surface_times, surfaces);
+  };
 
   auto finish = [&](const Eigen::Isometry3d& T) {
+    deskew_for(T);
     result.T_map_sensor = T;
     result.T_previous_sensor = last_pose_.inverse() * T;
     if (edges.size() + surfaces.size() > 0) map_->add(edges, surfaces, T);
@@ -228,6 +249,7 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
   Correspondences c;
   int iterations = 0;
   for (int step = 0; step < settings_.optimization_steps; ++step) {
+    deskew_for(pose);
     c = associate(*map_, edges, surfaces, pose, settings_.max_correspondence_distance_m);
     if (c.size() < kMinCorrespondences) {
       result.edge_correspondences = c.lines.size();

@@ -39,12 +39,12 @@ class FeatureOdometryLocator final : public OdometryLocator {
 
   std::optional<ScanPlacement> locate(const Scan& scan, std::string& why) override {
     const FeatureSet found = features::extract_features(scan, features_);
-    // The features are registered as measured, over the whole sweep: the pose that fits them
-    // best is the sensor's pose at about their mean time, and every scan's features enter the
-    // feature map the same way, so the poses agree with each other. (Deskewing the features
-    // with the last motion before registration fed each motion error into the next scan's
-    // estimate and made it oscillate.) The pose at the stamp and the motion over the scan
-    // then follow from the motion estimated between the scans.
+    // With odometry.deskew the registration deskews the features with the motion it is
+    // estimating for this scan (FeatureOdometry) and gives the pose at the stamp. Without it
+    // the features are registered as measured, over the whole sweep: the pose that fits them
+    // best is the sensor's at about their mean time, and the pose at the stamp follows from
+    // the motion between the scans. (Deskewing the features with the last scan's motion
+    // before registration fed each motion error into the next estimate and made it oscillate.)
     const OdometryResult result = odometry_.register_scan(found);
     ++counts_.scans;
     counts_.features_sum += static_cast<double>(found.size());
@@ -66,7 +66,7 @@ class FeatureOdometryLocator final : public OdometryLocator {
     placed.sequence = scan.sequence;
     placed.stamp_ns = scan.stamp_ns;
     placed.T_map_sensor = T_map_first_ * result.T_map_sensor;
-    if (moving)
+    if (moving && !deskew_)
       placed.T_map_sensor =
           placed.T_map_sensor * part_of(last_motion_, -fit_time_s / last_period_s_);
     placed.diagnostics = result.diagnostics;

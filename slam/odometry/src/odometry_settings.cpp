@@ -15,6 +15,7 @@ OdometrySettings from_config(const config::Config& config) {
   s.degeneracy_threshold = c.degeneracy_threshold;
   s.max_speed_m_s = c.max_speed_m_s;
   s.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
+  s.deskew = c.deskew;
   return s;
 }
 

@@ -28,4 +28,24 @@ std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& po
   return kept;
 }
 
+std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& points,
+                                          const std::vector<float>& times, double voxel_m,
+                                          std::vector<float>* kept_times) {
+  const auto inverse = static_cast<float>(1.0 / voxel_m);
+  const bool timed = times.size() == points.size();
+  std::unordered_set<uint64_t> taken;
+  taken.reserve(points.size());
+  std::vector<Eigen::Vector3f> kept;
+  kept.reserve(points.size());
+  kept_times->clear();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;
+    if (!taken.insert(voxel_key(p, inverse)).second) continue;
+    kept.push_back(p);
+    kept_times->push_back(timed ? times[i] : 0.0f);
+  }
+  return kept;
+}
+
 }  // namespace featsense::slam::odometry

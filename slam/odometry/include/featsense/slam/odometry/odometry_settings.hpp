@@ -16,6 +16,9 @@ struct OdometrySettings {
   double degeneracy_threshold = 0.0;
   double max_speed_m_s = 0.0;
   double max_turn_rate_rad_s = 0.0;
+  /// Register the features deskewed to the scan's stamp with the motion being estimated
+  /// (re-deskewed at every outer loop); false: as measured.
+  bool deskew = false;
 };
 
 /// The settings of config's odometry section (4 solver iterations per outer loop, as F-LOAM).

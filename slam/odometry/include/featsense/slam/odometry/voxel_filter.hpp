@@ -16,4 +16,10 @@ uint64_t voxel_key(const Eigen::Vector3f& p, float inverse_voxel);
 std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& points,
                                           double voxel_m);
 
+/// The same, keeping each kept point's time: `times` has one per point (or is empty, then
+/// `kept_times` gets 0 for each).
+std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& points,
+                                          const std::vector<float>& times, double voxel_m,
+                                          std::vector<float>* kept_times);
+
 }  // namespace featsense::slam::odometry
