@@ -36,7 +36,7 @@ struct LocatedScan {
 };
 
 struct PipelineSettings {
-  size_t queue_capacity = 4;  ///< scans per queue
+  size_t queue_capacity = 4;                                       ///< scans per queue
   double flush_interval_s = config::MapConfig{}.flush_interval_s;  ///< map.flush_interval
   FrameRange range;
   std::optional<size_t> total_frames;  ///< for the progress display, when known

@@ -10,8 +10,8 @@
 namespace featsense::slam {
 
 struct FeatureSet {
-  uint64_t sequence = 0;  ///< the scan's index in its recording
-  int64_t stamp_ns = 0;   ///< the scan's stamp
+  uint64_t sequence = 0;                  ///< the scan's index in its recording
+  int64_t stamp_ns = 0;                   ///< the scan's stamp
   std::vector<Eigen::Vector3f> edges;     ///< sensor frame, metres
   std::vector<float> edge_time_s;         ///< per edge point, seconds after stamp_ns
   std::vector<Eigen::Vector3f> surfaces;  ///< sensor frame, metres
