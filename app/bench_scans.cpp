@@ -24,14 +24,10 @@ PreparedScans prepare_builtin(const std::string& scene, int count) {
     const double frame_start = frame / settings.sensor.rate_hz;
     slam::ScanPlacement placement;
     placement.T_map_sensor = slam::box_room_pose(settings, frame_start);
-    placement.column_T_map_sensor.assign(static_cast<size_t>(scan->cols), placement.T_map_sensor);
-    const std::vector<std::optional<float>> times = scan->column_time_offsets_s();
-    for (size_t col = 0; col < times.size(); ++col) {
-      if (times[col]) {
-        placement.column_T_map_sensor[col] =
-            slam::box_room_pose(settings, frame_start + static_cast<double>(*times[col]));
-      }
-    }
+    placement.column_T_map_sensor =
+        slam::column_poses(*scan, placement.T_map_sensor, [&](double t) {
+          return std::optional<Eigen::Isometry3d>(slam::box_room_pose(settings, frame_start + t));
+        });
     prepared.rays.push_back(scan_to_rays(*scan, placement));
     prepared.input_points += prepared.rays.back().size();
     ++frame;

@@ -15,6 +15,7 @@
 #include "featsense/slam/odometry/local_feature_map.hpp"
 #include "featsense/slam/odometry/point_residuals.hpp"
 #include "featsense/slam/odometry/voxel_filter.hpp"
+#include "featsense/slam/trajectory/pose_interpolation.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
@@ -141,11 +142,7 @@ Matrix6d information_at(const Correspondences& c, const Eigen::Isometry3d& T) {
 
 /// The motion `m` scaled to `s` times its length (rotation angle and translation).
 Eigen::Isometry3d scaled(const Eigen::Isometry3d& m, double s) {
-  const Eigen::AngleAxisd turn(m.rotation());
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::AngleAxisd(turn.angle() * s, turn.axis()).toRotationMatrix();
-  out.translation() = m.translation() * s;
-  return out;
+  return interpolate_pose(Eigen::Isometry3d::Identity(), m, s);
 }
 
 /// The tangent step [w, dt] from `from` to `to`: to = (Exp(w) R_from, t_from + dt).

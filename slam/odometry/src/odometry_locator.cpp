@@ -7,19 +7,14 @@
 
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
+#include "featsense/slam/trajectory/pose_interpolation.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
 
-/// The fraction `s` of a rigid motion at constant velocity: rotation by slerp from the
-/// identity, translation in proportion (the two decoupled, as the pose interpolation of
-/// given trajectories does).
+/// The fraction `s` of a rigid motion at constant velocity (negative: before it began).
 Eigen::Isometry3d part_of(const Eigen::Isometry3d& motion, double s) {
-  const Eigen::Quaterniond q(motion.linear());
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond::Identity().slerp(s, q).normalized().toRotationMatrix();
-  out.translation() = s * motion.translation();
-  return out;
+  return interpolate_pose(Eigen::Isometry3d::Identity(), motion, s);
 }
 
 /// The mean of `times` (seconds after the stamp), 0 when empty.
@@ -71,13 +66,10 @@ class FeatureOdometryLocator final : public OdometryLocator {
           placed.T_map_sensor * part_of(last_motion_, -fit_time_s / last_period_s_);
     placed.diagnostics = result.diagnostics;
     if (deskew_ && moving) {
-      placed.column_T_map_sensor.assign(static_cast<size_t>(scan.cols), placed.T_map_sensor);
-      const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
-      for (size_t col = 0; col < times.size(); ++col) {
-        if (!times[col]) continue;
-        const double s = static_cast<double>(*times[col]) / last_period_s_;
-        placed.column_T_map_sensor[col] = placed.T_map_sensor * part_of(last_motion_, s);
-      }
+      placed.column_T_map_sensor = column_poses(scan, placed.T_map_sensor, [&](double t) {
+        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor *
+                                                part_of(last_motion_, t / last_period_s_));
+      });
     }
     return placed;
   }

@@ -16,16 +16,8 @@ uint64_t voxel_key(const Eigen::Vector3f& p, float inverse_voxel) {
 
 std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& points,
                                           double voxel_m) {
-  const auto inverse = static_cast<float>(1.0 / voxel_m);
-  std::unordered_set<uint64_t> taken;
-  taken.reserve(points.size());
-  std::vector<Eigen::Vector3f> kept;
-  kept.reserve(points.size());
-  for (const Eigen::Vector3f& p : points) {
-    if (!p.allFinite()) continue;
-    if (taken.insert(voxel_key(p, inverse)).second) kept.push_back(p);
-  }
-  return kept;
+  std::vector<float> kept_times;
+  return voxel_filter(points, {}, voxel_m, &kept_times);
 }
 
 std::vector<Eigen::Vector3f> voxel_filter(const std::vector<Eigen::Vector3f>& points,

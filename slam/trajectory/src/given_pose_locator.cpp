@@ -32,8 +32,12 @@ class StampedPoses final : public ScanLocator {
     placed.sequence = scan.sequence;
     placed.stamp_ns = scan.stamp_ns;
     placed.T_map_sensor = *pose;
-    if (deskew_ && !scan.time_offset_s.empty())
-      placed.column_T_map_sensor = column_poses(scan, *pose);
+    if (deskew_ && !scan.time_offset_s.empty()) {
+      // Times outside the trajectory keep the scan's pose.
+      placed.column_T_map_sensor = column_poses(scan, *pose, [&](double offset_s) {
+        return poses_.at(scan.stamp_ns + static_cast<int64_t>(offset_s * 1e9));
+      });
+    }
     return placed;
   }
 
@@ -43,20 +47,6 @@ class StampedPoses final : public ScanLocator {
   }
 
  private:
-  /// The pose at each column's time (Scan::column_time_offsets_s); columns without a valid
-  /// point, and times outside the trajectory, keep the scan's pose.
-  std::vector<Eigen::Isometry3d> column_poses(const Scan& scan, const Eigen::Isometry3d& at_stamp) {
-    std::vector<Eigen::Isometry3d> poses(static_cast<size_t>(scan.cols), at_stamp);
-    const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
-    for (size_t col = 0; col < times.size(); ++col) {
-      if (!times[col]) continue;
-      const double offset_s = static_cast<double>(*times[col]);
-      const auto at = poses_.at(scan.stamp_ns + static_cast<int64_t>(offset_s * 1e9));
-      if (at) poses[col] = *at;
-    }
-    return poses;
-  }
-
   PoseInterpolator poses_;
   bool deskew_;
 };

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,6 +42,13 @@ struct ScanPlacement {
 
   bool deskewed() const { return !column_T_map_sensor.empty(); }
 };
+
+/// The sensor's pose for each column of `scan` (ScanPlacement::column_T_map_sensor):
+/// `pose_at(t)` at the column's time t (Scan::column_time_offsets_s, seconds after the
+/// stamp); `at_stamp` for a column without a valid point, or where `pose_at` has no pose.
+std::vector<Eigen::Isometry3d> column_poses(
+    const Scan& scan, const Eigen::Isometry3d& at_stamp,
+    const std::function<std::optional<Eigen::Isometry3d>(double seconds_after_stamp)>& pose_at);
 
 class ScanLocator {
  public:
