@@ -8,7 +8,6 @@
 
 #include <chrono>
 #include <ctime>
-#include <iostream>
 #include <sstream>
 
 #include "bench_scans.hpp"
@@ -188,11 +187,6 @@ nlohmann::json run_bench_mesh(const BenchMeshOptions& options, const CliContext&
       {"triangles_per_s", median_s > 0.0 ? static_cast<double>(stats.triangles) / median_s : 0.0}};
 }
 
-void print_result(const nlohmann::json& result, const std::optional<std::string>& json_path) {
-  if (json_path && *json_path != "-") write_json(result, *json_path);
-  std::cout << result.dump(2) << "\n";
-}
-
 Command register_bench_mesh(CLI::App& bench, const CliContext& context) {
   auto options = std::make_shared<BenchMeshOptions>();
   CLI::App* mesh = bench.add_subcommand(
@@ -208,7 +202,7 @@ Command register_bench_mesh(CLI::App& bench, const CliContext& context) {
       ->capture_default_str();
   mesh->add_option("--json", options->json_path, "Write the JSON here too ('-' = stdout only)");
   return {mesh, [options, &context] {
-            print_result(run_bench_mesh(*options, context), options->json_path);
+            print_bench_result(run_bench_mesh(*options, context), options->json_path);
           }};
 }
 
@@ -240,7 +234,8 @@ std::vector<Command> register_bench(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   tsdf->add_option("--json", options->json_path, "Write the JSON here too ('-' = stdout only)");
   const Command tsdf_command{tsdf, [options, &context] {
-                               print_result(run_bench_tsdf(*options, context), options->json_path);
+                               print_bench_result(run_bench_tsdf(*options, context),
+                                                  options->json_path);
                              }};
   return {tsdf_command, register_bench_mesh(*bench, context)};
 }

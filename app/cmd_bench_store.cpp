@@ -7,7 +7,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <iostream>
 
 #include "bench_scans.hpp"
 #include "commands.hpp"
@@ -139,10 +138,7 @@ Command register_bench_store(CLI::App& bench, const CliContext& context) {
   command->add_option("--dir", options->dir, "Folder for the store (default: the temp folder)");
   command->add_option("--json", options->json_path, "Write the JSON here too ('-' = stdout only)");
   return {command, [options, &context] {
-            const nlohmann::json result = run_bench_store(*options, context);
-            if (options->json_path && *options->json_path != "-")
-              write_json(result, *options->json_path);
-            std::cout << result.dump(2) << "\n";
+            print_bench_result(run_bench_store(*options, context), options->json_path);
           }};
 }
 

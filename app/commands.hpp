@@ -26,6 +26,8 @@ Command register_simulate(CLI::App& app, const CliContext& context);
 Command register_demo(CLI::App& app, const CliContext& context);
 /// `featsense bench store ...`, added to the `bench` command.
 Command register_bench_store(CLI::App& bench, const CliContext& context);
+/// `featsense bench features|odometry ...`: the front end's speed, added to `bench`.
+std::vector<Command> register_bench_front_end(CLI::App& bench, const CliContext& context);
 /// `featsense map INPUT -o OUT --gt TRAJ ...`: the mapping pipeline.
 Command register_map(CLI::App& app, const CliContext& context);
 /// `featsense bench tsdf|mesh ...`: speed figures as JSON (one command per benchmark).

@@ -22,6 +22,11 @@ void write_json(const nlohmann::json& document, const std::string& path) {
   if (!file) throw std::runtime_error(path + ": writing the JSON output failed (disk full?)");
 }
 
+void print_bench_result(const nlohmann::json& result, const std::optional<std::string>& json_path) {
+  if (json_path && *json_path != "-") write_json(result, *json_path);
+  std::cout << result.dump(2) << "\n";
+}
+
 nlohmann::json min_median_max(const std::vector<double>& values) {
   const slam::ErrorStatistics statistics = slam::error_statistics(values);
   return {{"min", statistics.min}, {"median", statistics.median}, {"max", statistics.max}};

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,10 @@ namespace featsense::app {
 /// Writes `document` (pretty-printed) to `path`, or to stdout when path is "-".
 /// Throws std::runtime_error naming the path when it cannot be written.
 void write_json(const nlohmann::json& document, const std::string& path);
+
+/// A benchmark's result: printed to stdout, and written to `json_path` too unless it is
+/// absent or "-".
+void print_bench_result(const nlohmann::json& result, const std::optional<std::string>& json_path);
 
 /// {"min", "median", "max"} of the values (all 0 when empty).
 nlohmann::json min_median_max(const std::vector<double>& values);

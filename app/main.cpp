@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
   for (auto& command : featsense::app::register_bench(app, context)) commands.push_back(command);
   commands.push_back(featsense::app::register_bench_store(*app.get_subcommand("bench"), context));
+  for (auto& command :
+       featsense::app::register_bench_front_end(*app.get_subcommand("bench"), context))
+    commands.push_back(command);
 
   // Global options are parsed wherever they stand; say so in every subcommand's help.
   for (const auto& command : commands) {
