@@ -131,6 +131,7 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   slam::odometry::FeatureOdometry odometry(slam::odometry::from_config(config));
 
   std::vector<double> features_ms, registration_ms, total_ms, feature_counts;
+  std::vector<double> association_ms, solve_ms, map_update_ms;
   size_t degenerate = 0, failed = 0;
   slam::Trajectory estimate;
   for (size_t i = 0; i < scans.scans.size(); ++i) {
@@ -147,6 +148,9 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
     // The first scan only starts the map: its registration time is not a registration's.
     if (i == 0) continue;
     features_ms.push_back(features);
+    association_ms.push_back(result.timing.association_ms);
+    solve_ms.push_back(result.timing.solve_ms);
+    map_update_ms.push_back(result.timing.map_update_ms);
     registration_ms.push_back(registration);
     total_ms.push_back(features + registration);
     feature_counts.push_back(static_cast<double>(found.size()));
@@ -158,6 +162,10 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   result["features"] = timing_json(features_ms);
   result["registration"] = timing_json(registration_ms);
   result["total"] = timing_json(total_ms);
+  result["registration_stages_median_ms"] = {
+      {"association", summarize_ms(association_ms).median_ms},
+      {"solve", summarize_ms(solve_ms).median_ms},
+      {"map_update", summarize_ms(map_update_ms).median_ms}};
   result["features_per_scan"] = min_median_max(feature_counts);
   result["degenerate_scans"] = degenerate;
   result["failed_scans"] = failed;

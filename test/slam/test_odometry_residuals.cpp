@@ -40,7 +40,8 @@ void check_jacobians(const Residual& r, const Eigen::Quaterniond& q, const Eigen
     numeric.col(i) = (residual_at(r, plus(q, w), t) - residual_at(r, plus(q, -w), t)) / (2 * h);
     numeric.col(3 + i) = (residual_at(r, q, t + w) - residual_at(r, q, t - w)) / (2 * h);
   }
-  const Eigen::Matrix<double, n, 6> tangent = r.tangent_jacobian(q);
+  // tangent_jacobian holds the point rigid; a deskewed point moves `gain` times as far.
+  const Eigen::Matrix<double, n, 6> tangent = r.gain * r.tangent_jacobian(q);
   EXPECT_LT((tangent - numeric).cwiseAbs().maxCoeff(), 1e-6) << tangent << "\n" << numeric;
 
   // The ambient Jacobians Ceres gets, through Plus' Jacobian, give the same.
@@ -73,7 +74,32 @@ TEST(OdometryResiduals, JacobiansMatchCentralDifferencesOnTheManifold) {
     check_jacobians(PointToLine{10.0 * vec(), 3.0 * vec(), vec().normalized()}, q, t);
     const Eigen::Vector3d n = vec().normalized();
     check_jacobians(PointToPlane{10.0 * vec(), n, u(rng)}, q, t);
+    // Deskewed points, coupled to the pose (anchor, gain 1 + s).
+    PointToLine line{10.0 * vec(), 3.0 * vec(), vec().normalized()};
+    line.anchor = 10.0 * vec();
+    line.gain = 1.0 + 0.5 * (u(rng) + 1.0);
+    check_jacobians(line, q, t);
+    PointToPlane plane{10.0 * vec(), n, u(rng)};
+    plane.anchor = 10.0 * vec();
+    plane.gain = 1.0 + 0.5 * (u(rng) + 1.0);
+    check_jacobians(plane, q, t);
   }
+}
+
+TEST(OdometryResiduals, ACoupledPointMovesGainTimesAsFarAsTheRigidOne) {
+  const Eigen::Quaterniond q0(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d t0(1.0, 2.0, 0.5);
+  PointToPlane rigid{Eigen::Vector3d(4.0, -1.0, 0.3), Eigen::Vector3d(1, 2, 2).normalized(), 0.7};
+  PointToPlane coupled = rigid;
+  coupled.anchor = q0 * rigid.point + t0;  // where the point lies at the pose it was deskewed at
+  coupled.gain = 1.75;
+  // At that pose both agree; away from it the coupled residual changes 1.75 times as much.
+  EXPECT_NEAR(residual_at(coupled, q0, t0)(0), residual_at(rigid, q0, t0)(0), 1e-12);
+  const Eigen::Quaterniond q1 = plus(q0, Eigen::Vector3d(0.01, -0.02, 0.03));
+  const Eigen::Vector3d t1 = t0 + Eigen::Vector3d(0.05, -0.02, 0.01);
+  const double rigid_change = residual_at(rigid, q1, t1)(0) - residual_at(rigid, q0, t0)(0);
+  const double coupled_change = residual_at(coupled, q1, t1)(0) - residual_at(coupled, q0, t0)(0);
+  EXPECT_NEAR(coupled_change, 1.75 * rigid_change, 1e-12);
 }
 
 TEST(OdometryResiduals, DistancesAreThoseOfTheGeometry) {

@@ -9,9 +9,10 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
-Eigen::Vector3d map_point(const double* q, const double* t, const Eigen::Vector3d& p) {
+Eigen::Vector3d map_point(const double* q, const double* t, const Eigen::Vector3d& p,
+                          const Eigen::Vector3d& anchor, double gain) {
   const Eigen::Map<const Eigen::Quaterniond> rotation(q);
-  return rotation * p + Eigen::Map<const Eigen::Vector3d>(t);
+  return anchor + gain * (rotation * p + Eigen::Map<const Eigen::Vector3d>(t) - anchor);
 }
 
 /// d(residual)/d(tangent) from d(residual)/dx: a left turn w moves x by -[R p]x w.
@@ -40,11 +41,11 @@ Eigen::Matrix<double, 3, 4> rotated_point_jacobian(const Eigen::Quaterniond& q,
 
 void PointToLine::evaluate(const double* q, const double* t, double* residual, double* jacobian_q,
                            double* jacobian_t) const {
-  const Eigen::Vector3d x = map_point(q, t, point);
+  const Eigen::Vector3d x = map_point(q, t, point, anchor, gain);
   Eigen::Map<Eigen::Vector3d> out_residual(residual);
   out_residual = (x - line_point).cross(direction);
   if (jacobian_q == nullptr && jacobian_t == nullptr) return;
-  const Eigen::Matrix3d d_x = -skew(direction);  // (x - a) x d = -d x (x - a)
+  const Eigen::Matrix3d d_x = -gain * skew(direction);  // (x - a) x d = -d x (x - a)
   if (jacobian_q != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> out_jacobian_q(jacobian_q);
     out_jacobian_q = d_x * rotated_point_jacobian(Eigen::Map<const Eigen::Quaterniond>(q), point);
@@ -61,15 +62,15 @@ Eigen::Matrix<double, 3, 6> PointToLine::tangent_jacobian(const Eigen::Quaternio
 
 void PointToPlane::evaluate(const double* q, const double* t, double* residual, double* jacobian_q,
                             double* jacobian_t) const {
-  residual[0] = normal.dot(map_point(q, t, point)) + offset;
+  residual[0] = normal.dot(map_point(q, t, point, anchor, gain)) + offset;
+  const Eigen::RowVector3d d_x = gain * normal.transpose();
   if (jacobian_q != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 1, 4>> out_jacobian_q(jacobian_q);
-    out_jacobian_q =
-        normal.transpose() * rotated_point_jacobian(Eigen::Map<const Eigen::Quaterniond>(q), point);
+    out_jacobian_q = d_x * rotated_point_jacobian(Eigen::Map<const Eigen::Quaterniond>(q), point);
   }
   if (jacobian_t != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 1, 3>> out_jacobian_t(jacobian_t);
-    out_jacobian_t = normal.transpose();
+    out_jacobian_t = d_x;
   }
 }
 

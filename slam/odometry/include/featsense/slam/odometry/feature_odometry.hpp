@@ -14,6 +14,8 @@
 namespace featsense::slam::odometry {
 
 class LocalFeatureMap;
+struct TimedFeatures;
+struct RegistrationStart;
 
 class FeatureOdometry {
  public:
@@ -27,12 +29,21 @@ class FeatureOdometry {
   /// of the prediction beyond max_speed / max_turn_rate over the elapsed time, or a cost
   /// above the prediction's) give the prediction, with converged=false and the reason.
   /// In degenerate directions the pose keeps the prediction. Every scan with features is
-  /// then added to the map at the pose given.
+  /// then added to the map at the pose given. The second scan restarts the map with the
+  /// first one deskewed, once the motion is known, and is registered again.
   OdometryResult register_scan(const FeatureSet& features);
 
  private:
+  std::unique_ptr<LocalFeatureMap> new_map() const;
+  Eigen::Isometry3d restart_map(const TimedFeatures& raw, const RegistrationStart& start,
+                                const Eigen::Isometry3d& pose, OdometryResult& result);
+  void add_to_map(const TimedFeatures& raw, const Eigen::Isometry3d& pose, int64_t stamp_ns,
+                  OdometryResult& result);
+
   OdometrySettings settings_;
   std::unique_ptr<LocalFeatureMap> map_;
+  /// The first scan's features as measured, until the second scan has restarted the map.
+  std::unique_ptr<TimedFeatures> first_scan_;
   bool started_ = false;
   int64_t last_stamp_ns_ = 0;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();

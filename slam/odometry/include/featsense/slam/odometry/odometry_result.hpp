@@ -39,6 +39,13 @@ struct OdometryResult {
   size_t surface_correspondences = 0;  ///< in the last outer loop
   size_t map_edges = 0;                ///< the local map after this scan was added
   size_t map_surfaces = 0;
+
+  /// Where the registration's time went, milliseconds.
+  struct Timing {
+    double association_ms = 0.0;  ///< nearest neighbours and line / plane fits, all loops
+    double solve_ms = 0.0;        ///< Ceres, all loops
+    double map_update_ms = 0.0;   ///< adding the scan to the local map, pruning, the trees
+  } timing;
 };
 
 }  // namespace featsense::slam::odometry

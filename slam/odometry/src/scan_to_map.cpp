@@ -1,0 +1,299 @@
+#include "scan_to_map.hpp"
+
+#include <ceres/ceres.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/slam/odometry/degeneracy.hpp"
+#include "featsense/slam/odometry/feature_fit.hpp"
+#include "featsense/slam/odometry/point_residuals.hpp"
+
+namespace featsense::slam::odometry {
+namespace {
+
+constexpr int kNeighbours = 5;
+/// Fewer correspondences than this do not pin 6 degrees of freedom down reliably.
+constexpr size_t kMinCorrespondences = 10;
+/// An outer loop that moves the pose less than this ends the registration: far below the
+/// range noise, and small enough that the errors it leaves do not add up over a run.
+constexpr double kSettledMoveM = 1e-4;
+
+template <class Residual>
+class CostFunction final : public ceres::SizedCostFunction<Residual::kResiduals, 4, 3> {
+ public:
+  explicit CostFunction(const Residual& residual) : residual_(residual) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    residual_.evaluate(parameters[0], parameters[1], residuals,
+                       jacobians != nullptr ? jacobians[0] : nullptr,
+                       jacobians != nullptr ? jacobians[1] : nullptr);
+    return true;
+  }
+
+ private:
+  Residual residual_;
+};
+
+struct Correspondences {
+  std::vector<PointToLine> lines;
+  std::vector<PointToPlane> planes;
+  size_t size() const { return lines.size() + planes.size(); }
+};
+
+/// The correspondences of `points` at pose T: `search` gives a map point's neighbours, `make`
+/// the residual of a fitted line or plane (or nothing). A point measured `times[i]` after the
+/// stamp moves (1 + times[i] / period_s) times as far as the pose (point_residuals.hpp); with
+/// period_s 0 the points are rigid.
+template <class Residual, class Search, class Make>
+std::vector<Residual> match(const std::vector<Eigen::Vector3f>& points,
+                            const std::vector<float>& times, double period_s,
+                            const Eigen::Isometry3d& T, Search&& search, Make&& make) {
+  // The nearest-neighbour searches dominate: both cores share them, the order stays the scan's.
+  std::vector<std::optional<Residual>> found(points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i < range.end(); ++i) {
+                        const Eigen::Vector3d p = points[i].cast<double>();
+                        const Eigen::Vector3d x = T * p;
+                        const std::vector<Eigen::Vector3d> near = search(x);
+                        if (near.size() != static_cast<size_t>(kNeighbours)) continue;
+                        found[i] = make(p, near);
+                        if (found[i] && period_s > 0.0) {
+                          found[i]->anchor = x;
+                          found[i]->gain = 1.0 + static_cast<double>(times[i]) / period_s;
+                        }
+                      }
+                    });
+  std::vector<Residual> out;
+  for (const auto& f : found) {
+    if (f) out.push_back(*f);
+  }
+  return out;
+}
+
+Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& points, double period_s,
+                          const Eigen::Isometry3d& T, double max_distance) {
+  Correspondences c;
+  c.lines = match<PointToLine>(
+      points.edges, points.edge_time_s, period_s, T,
+      [&](const Eigen::Vector3d& x) { return map.nearest_edges(x, kNeighbours, max_distance); },
+      [](const Eigen::Vector3d& p,
+         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToLine> {
+        const auto line = fit_line(near);
+        if (!line) return std::nullopt;
+        PointToLine residual;
+        residual.point = p;
+        residual.line_point = line->point;
+        residual.direction = line->direction;
+        return residual;
+      });
+  c.planes = match<PointToPlane>(
+      points.surfaces, points.surface_time_s, period_s, T,
+      [&](const Eigen::Vector3d& x) { return map.nearest_surfaces(x, kNeighbours, max_distance); },
+      [](const Eigen::Vector3d& p,
+         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
+        const auto plane = fit_plane(near);
+        if (!plane) return std::nullopt;
+        PointToPlane residual;
+        residual.point = p;
+        residual.normal = plane->normal;
+        residual.offset = plane->offset;
+        return residual;
+      });
+  return c;
+}
+
+/// The robust cost (Ceres' Huber) and the mean distance of the correspondences at a pose.
+struct Cost {
+  double robust = 0.0;
+  double mean_distance = 0.0;
+};
+
+Cost cost_at(const Correspondences& c, const Eigen::Isometry3d& T, double huber) {
+  const Eigen::Quaterniond q(T.rotation());
+  const Eigen::Vector3d t = T.translation();
+  Cost cost;
+  auto add = [&](double distance2) {
+    cost.robust +=
+        distance2 <= huber * huber ? distance2 : 2.0 * huber * std::sqrt(distance2) - huber * huber;
+    cost.mean_distance += std::sqrt(distance2);
+  };
+  for (const PointToLine& l : c.lines) {
+    Eigen::Vector3d r;
+    l.evaluate(q.coeffs().data(), t.data(), r.data(), nullptr, nullptr);
+    add(r.squaredNorm());
+  }
+  for (const PointToPlane& p : c.planes) {
+    double r = 0.0;
+    p.evaluate(q.coeffs().data(), t.data(), &r, nullptr, nullptr);
+    add(r * r);
+  }
+  if (c.size() > 0) cost.mean_distance /= static_cast<double>(c.size());
+  return cost;
+}
+
+/// J^T J / N over the residual rows, in the tangent [rotation, translation].
+Matrix6d information_at(const Correspondences& c, const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.rotation());
+  Matrix6d h = Matrix6d::Zero();
+  size_t rows = 0;
+  for (const PointToLine& l : c.lines) {
+    const Eigen::Matrix<double, 3, 6> j = l.tangent_jacobian(q);
+    h += j.transpose() * j;
+    rows += 2;  // the residual lies in the plane normal to the line: two rows' worth
+  }
+  for (const PointToPlane& p : c.planes) {
+    const Eigen::Matrix<double, 1, 6> j = p.tangent_jacobian(q);
+    h += j.transpose() * j;
+    rows += 1;
+  }
+  return rows > 0 ? Matrix6d(h / static_cast<double>(rows)) : Matrix6d::Zero();
+}
+
+/// The tangent step [w, dt] from `from` to `to`: to = (Exp(w) R_from, t_from + dt).
+Vector6d tangent_between(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to) {
+  const Eigen::AngleAxisd turn(Eigen::Matrix3d(to.rotation() * from.rotation().transpose()));
+  Vector6d d;
+  d.head<3>() = turn.angle() * turn.axis();
+  d.tail<3>() = to.translation() - from.translation();
+  return d;
+}
+
+Eigen::Isometry3d apply_tangent(const Eigen::Isometry3d& from, const Vector6d& d) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  const double angle = d.head<3>().norm();
+  const Eigen::Matrix3d turn =
+      angle > 0.0 ? Eigen::AngleAxisd(angle, d.head<3>() / angle).toRotationMatrix()
+                  : Eigen::Matrix3d::Identity();
+  out.linear() = turn * from.rotation();
+  out.translation() = from.translation() + d.tail<3>();
+  return out;
+}
+
+bool finite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// One outer loop's solve: Ceres from `pose` over the correspondences.
+Eigen::Isometry3d solve(const Correspondences& c, const Eigen::Isometry3d& pose,
+                        const OdometrySettings& settings, int& iterations) {
+  Eigen::Quaterniond q(pose.rotation());
+  Eigen::Vector3d t = pose.translation();
+  ceres::Problem::Options problem_options;
+  problem_options.enable_fast_removal = false;
+  ceres::Problem problem(problem_options);
+  problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  problem.AddParameterBlock(t.data(), 3);
+  auto* loss = new ceres::HuberLoss(settings.huber_loss_m);
+  for (const PointToLine& l : c.lines) {
+    problem.AddResidualBlock(new CostFunction<PointToLine>(l), loss, q.coeffs().data(), t.data());
+  }
+  for (const PointToPlane& p : c.planes) {
+    problem.AddResidualBlock(new CostFunction<PointToPlane>(p), loss, q.coeffs().data(), t.data());
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = settings.solver_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-16;
+  options.parameter_tolerance = 1e-14;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+  Eigen::Isometry3d solved = Eigen::Isometry3d::Identity();
+  solved.linear() = q.normalized().toRotationMatrix();
+  solved.translation() = t;
+  return solved;
+}
+
+}  // namespace
+
+bool settled(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double move_m) {
+  const double turn_rad = move_m / 10.0;  // the same move at 10 m
+  const Vector6d change = tangent_between(from, to);
+  return change.tail<3>().norm() < move_m && change.head<3>().norm() < turn_rad;
+}
+
+Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeatures& raw,
+                                  const RegistrationStart& start, const OdometrySettings& settings,
+                                  OdometryResult& result) {
+  const Eigen::Isometry3d& prediction = start.prediction;
+  const bool deskew = settings.deskew && start.elapsed_s > 0.0;
+  const auto fail = [&](std::string why) {
+    result.diagnostics.converged = false;
+    result.reason = std::move(why);
+    return prediction;
+  };
+
+  Eigen::Isometry3d pose = prediction;
+  Correspondences c;
+  int iterations = 0;
+  for (int step = 0; step < settings.optimization_steps; ++step) {
+    const auto association_start = Clock::now();
+    const TimedFeatures points =
+        deskew ? deskewed(raw, start.previous.inverse() * pose, start.elapsed_s) : raw;
+    c = associate(map, points, deskew ? start.elapsed_s : 0.0, pose,
+                  settings.max_correspondence_distance_m);
+    result.timing.association_ms += ms_since(association_start);
+    if (c.size() < kMinCorrespondences) {
+      result.edge_correspondences = c.lines.size();
+      result.surface_correspondences = c.planes.size();
+      return fail("too few correspondences (" + std::to_string(c.size()) + ")");
+    }
+    const auto solve_start = Clock::now();
+    const Eigen::Isometry3d solved = solve(c, pose, settings, iterations);
+    result.timing.solve_ms += ms_since(solve_start);
+    if (!finite(solved)) return fail("the solve gave a non-finite pose");
+    const bool done = settled(pose, solved, kSettledMoveM);
+    pose = solved;
+    if (done) break;  // another association would find the same correspondences
+  }
+  result.diagnostics.iterations = iterations;
+  result.edge_correspondences = c.lines.size();
+  result.surface_correspondences = c.planes.size();
+
+  // Degeneracy: keep the prediction along the unobservable directions.
+  const Degeneracy degeneracy =
+      analyse_degeneracy(information_at(c, pose), settings.degeneracy_threshold);
+  result.information_eigenvalues = degeneracy.eigenvalues;
+  result.diagnostics.degenerate = degeneracy.degenerate();
+  result.degenerate_directions = degeneracy.unobservable;
+  if (degeneracy.degenerate()) {
+    result.reason = std::to_string(degeneracy.unobservable.size()) +
+                    " unobservable direction(s): the prediction is kept along them";
+    pose = apply_tangent(prediction,
+                         degeneracy.observable_projector * tangent_between(prediction, pose));
+  }
+
+  // Divergence: a correction too large for the time elapsed, or worse than the prediction.
+  const Vector6d correction = tangent_between(prediction, pose);
+  const double dt = std::max(start.elapsed_s, 1e-3);
+  if (!correction.allFinite() || correction.tail<3>().norm() > settings.max_speed_m_s * dt ||
+      correction.head<3>().norm() > settings.max_turn_rate_rad_s * dt) {
+    return fail("diverged: the correction of the prediction is too large for the time elapsed");
+  }
+  const Cost at_pose = cost_at(c, pose, settings.huber_loss_m);
+  const Cost at_prediction = cost_at(c, prediction, settings.huber_loss_m);
+  if (!(at_pose.robust <= at_prediction.robust * (1.0 + 1e-9) + 1e-18)) {
+    return fail("diverged: the cost is above the prediction's");
+  }
+  result.diagnostics.fitness_m = at_pose.mean_distance;
+  result.diagnostics.converged = true;
+  return pose;
+}
+
+}  // namespace featsense::slam::odometry
