@@ -71,8 +71,8 @@ struct OdometryConfig {
   bool intensity_fusion = true;
   bool deskew = true;
   // Registration (slam/odometry). Why each value: default.yaml.
-  double edge_voxel_m = 0.4;     ///< voxel of the local edge map and of each scan's edges
-  double surface_voxel_m = 0.8;  ///< voxel of the local surface map and of the scan's surfaces
+  double edge_voxel_m = 0.2;     ///< voxel of the local edge map and of each scan's edges
+  double surface_voxel_m = 0.4;  ///< voxel of the local surface map and of the scan's surfaces
   double map_radius_m = 50.0;    ///< map points farther than this from the sensor are dropped
   double max_correspondence_distance_m = 1.0;  ///< the 5 neighbours lie within this
   double huber_loss_m = 0.1;                   ///< residuals beyond this count linearly
