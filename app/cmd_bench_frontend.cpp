@@ -72,14 +72,6 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-nlohmann::json timing_json(const std::vector<double>& samples_ms) {
-  const TimingSummary t = summarize_ms(samples_ms);
-  return {{"median_ms", t.median_ms},
-          {"p95_ms", t.p95_ms},
-          {"max_ms", t.max_ms},
-          {"mean_ms", t.mean_ms}};
-}
-
 nlohmann::json common_json(const char* name, const FrontEndScans& scans,
                            const slam::features::FeatureSettings& settings) {
   const slam::Scan& first = scans.scans.front();

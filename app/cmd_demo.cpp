@@ -1,5 +1,6 @@
-// featsense demo: a built-in scene simulated, mapped with its true poses, meshed and compared
-// with the truth, in one command that needs nothing but the program.
+// featsense demo: a built-in scene simulated, mapped with poses that the odometry estimates
+// (or the true ones, --gt-poses), meshed and compared with the truth, in one command that
+// needs nothing but the program.
 
 #include <cstdio>
 #include <filesystem>
@@ -18,7 +19,8 @@ struct DemoOptions {
   std::string output = "featsense-demo";
   std::string scene = "lab";
   std::string path = "walk";
-  int frames = 0;  ///< 0: the whole path
+  int frames = 0;         ///< 0: the whole path
+  bool gt_poses = false;  ///< map with the true poses instead of the odometry's
   std::optional<std::string> backend;
 };
 
@@ -39,6 +41,15 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
   if (r.contains("mesh")) {
     std::printf("  mesh: %zu triangles, %zu vertices\n", r["mesh"]["triangles"].get<size_t>(),
                 r["mesh"]["vertices"].get<size_t>());
+  }
+  if (r.contains("eval") && r["eval"].contains("traj")) {
+    const nlohmann::json& t = r["eval"]["traj"];
+    std::printf(
+        "  poses estimated by the odometry: ATE %.1f mm (RMSE over %d poses, %.1f m of path)\n",
+        1e3 * t["ape"]["rmse"].get<double>(), t["ape"]["count"].get<int>(),
+        t["ground_truth_length_m"].get<double>());
+  } else {
+    std::printf("  mapped with the true poses\n");
   }
   if (r.contains("eval") && r["eval"].contains("mesh")) {
     const nlohmann::json& e = r["eval"]["mesh"];
@@ -80,8 +91,14 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   MeshReferences references;
   references.surface = truth / "gt_mesh.ply";
   references.seen = truth / "gt_points.ply";
-  const MapOutcome outcome =
-      map_recording(source, simulation.frame_poses(), map, config, references, context);
+  // The true path is known: with estimated poses it fixes the map's frame at the first
+  // pose and scores the odometry; with --gt-poses it is what the map is built with.
+  const KnownTrajectory truth_path{simulation.frame_poses(), true};
+  std::optional<slam::Trajectory> given;
+  if (options.gt_poses) given = truth_path.poses;
+  const MapOutcome outcome = map_recording(
+      source, given, options.gt_poses ? std::nullopt : std::optional<KnownTrajectory>(truth_path),
+      map, config, references, context);
   if (!context.quiet) print_summary(options, outcome);
 }
 
@@ -100,6 +117,8 @@ Command register_demo(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   command->add_option("--frames", options->frames, "Frames to simulate (default: the whole path)")
       ->check(CLI::Range(1, 100000));
+  command->add_flag("--gt-poses", options->gt_poses,
+                    "Map with the true poses instead of estimating them with the odometry");
   add_config_option(*command, kBackendOption, options->backend);
   return {command, [options, &context] { run_demo(*options, context); }};
 }

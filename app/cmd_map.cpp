@@ -26,6 +26,7 @@
 #include "map_store.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
+#include "timing_stats.hpp"
 
 namespace featsense::app {
 namespace {
@@ -68,15 +69,26 @@ slam::Trajectory read_poses(const MapOptions& options) {
 }
 
 /// The ground truth of a simulated recording (gt_trajectory.tum in its folder), if any.
-std::optional<slam::Trajectory> ground_truth_beside(const slam::SourceInfo& info) {
+std::optional<KnownTrajectory> ground_truth_beside(const slam::SourceInfo& info) {
   const fs::path file = fs::path(info.path) / "gt_trajectory.tum";
   if (!fs::is_directory(info.path) || !fs::is_regular_file(file)) return std::nullopt;
   try {
-    return slam::read_tum(file.string());
+    return KnownTrajectory{slam::read_tum(file.string()), true};
   } catch (const slam::TrajectoryError& e) {
     spdlog::warn("ignoring the ground truth beside the recording: {}", e.what());
     return std::nullopt;
   }
+}
+
+/// --reference-trajectory, else the ground truth beside a simulated recording (only where the
+/// poses are estimated: given poses are that truth).
+std::optional<KnownTrajectory> known_trajectory(const MapOptions& options,
+                                                const slam::SourceInfo& info) {
+  if (options.reference_trajectory) {
+    return KnownTrajectory{slam::read_trajectory(*options.reference_trajectory, "auto", {}), false};
+  }
+  if (options.gt) return std::nullopt;
+  return ground_truth_beside(info);
 }
 
 nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts) {
@@ -85,7 +97,10 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts) {
           {"failed_scans", counts.failed_scans},
           {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
           {"features_per_scan",
-           counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0}};
+           counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0},
+          {"timings",
+           {{"features", timing_json(counts.features_ms)},
+            {"registration", timing_json(counts.registration_ms)}}}};
 }
 
 tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
@@ -107,25 +122,25 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   std::optional<slam::Trajectory> poses;
   if (options.gt) poses = read_poses(options);
   std::unique_ptr<slam::ScanSource> source = options.input.open(config);
-  return map_recording(*source, std::move(poses), options, config,
+  const std::optional<KnownTrajectory> truth = known_trajectory(options, source->info());
+  return map_recording(*source, std::move(poses), truth, options, config,
                        find_mesh_references(options.input.input, options.reference), context);
 }
 
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
-                         const MapOptions& options, config::Config config,
-                         const MeshReferences& references, const CliContext& context) {
+                         const std::optional<KnownTrajectory>& truth, const MapOptions& options,
+                         config::Config config, const MeshReferences& references,
+                         const CliContext& context) {
   const FrameRange range = frame_range(options);
   const slam::SourceInfo& info = source.info();
-  // Without given poses, a simulated recording's ground truth (beside its scans) fixes the
-  // map frame at its first pose, so that the map and the path can be compared with the truth.
-  const std::optional<slam::Trajectory> truth = poses ? std::nullopt : ground_truth_beside(info);
   std::unique_ptr<slam::odometry::OdometryLocator> odometry;
   std::unique_ptr<slam::ScanLocator> given;
   if (poses) {
     given = slam::make_given_pose_locator(std::move(*poses), config.odometry.deskew);
   } else {
+    const bool anchored = truth && truth->starts_at_first_scan && !truth->poses.empty();
     odometry = slam::odometry::make_odometry_locator(
-        config, truth && !truth->empty() ? truth->poses.front() : Eigen::Isometry3d::Identity());
+        config, anchored ? truth->poses.poses.front() : Eigen::Isometry3d::Identity());
   }
   slam::ScanLocator* locator = given ? given.get() : odometry.get();
 
@@ -206,7 +221,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     try {
       const slam::TrajectoryEvaluationSettings eval_settings;
       report["eval"]["traj"] = trajectory_evaluation_json(
-          slam::evaluate_trajectory(result.poses, *truth, eval_settings), eval_settings);
+          slam::evaluate_trajectory(result.poses, truth->poses, eval_settings), eval_settings);
     } catch (const slam::TrajectoryError& e) {
       spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
     }
@@ -263,6 +278,11 @@ Command register_map(CLI::App& app, const CliContext& context) {
   command->add_option("--end", options->end, "Last scan to map (as --start)");
   command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
   command->add_flag("--no-mesh", options->no_mesh, "Write the map only, no mesh.ply / mesh.glb");
+  command
+      ->add_option("--reference-trajectory", options->reference_trajectory,
+                   "The true path (TUM or KITTI), to compare the poses with in report.json "
+                   "(default: the ground truth of a simulated sequence)")
+      ->check(CLI::ExistingFile);
   command
       ->add_option("--reference", options->reference,
                    "Surveyed mesh to evaluate the map's mesh against (default: the ground "

@@ -26,6 +26,7 @@ struct MapOptions {
   std::optional<std::string> start;
   std::optional<std::string> end;
   std::optional<std::string> reference;
+  std::optional<std::string> reference_trajectory;  ///< the true path, for eval.traj
   bool overwrite = false;
   bool no_mesh = false;
   bool print_summary = true;  ///< the one-line summary on stdout
@@ -34,6 +35,14 @@ struct MapOptions {
 struct MapOutcome {
   std::filesystem::path out;
   nlohmann::json report;  ///< as written to report.json
+};
+
+/// The true path where it is known, for the report's eval.traj (SE(3)-aligned, as `featsense
+/// eval traj`). A simulation's starts at the first scan: estimated poses then start there too,
+/// so that the map lies in the frame of the true surface and compares with it unaligned.
+struct KnownTrajectory {
+  slam::Trajectory poses;
+  bool starts_at_first_scan = false;
 };
 
 /// Maps INPUT (opened with the run's configuration) into OUT, with the poses of --gt or,
@@ -46,10 +55,11 @@ config::Config map_config(const MapOptions& options, const CliContext& context);
 
 /// Maps `source` with `poses` (given poses; nullopt: estimated by the odometry front end) and
 /// `config` (from map_config) into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb,
-/// report.json). Throws ConfigError, InputError, Interrupted
-/// (after writing the outputs) or std::runtime_error.
+/// report.json), comparing the path with `truth` where given. Throws ConfigError,
+/// InputError, Interrupted (after writing the outputs) or std::runtime_error.
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
-                         const MapOptions& options, config::Config config,
-                         const MeshReferences& references, const CliContext& context);
+                         const std::optional<KnownTrajectory>& truth, const MapOptions& options,
+                         config::Config config, const MeshReferences& references,
+                         const CliContext& context);
 
 }  // namespace featsense::app

@@ -23,4 +23,11 @@ TimingSummary summarize_ms(std::vector<double> samples_ms) {
   return s;
 }
 
+nlohmann::json timing_json(const std::vector<double>& samples_ms) {
+  const TimingSummary s = summarize_ms(samples_ms);
+  return {{"count", s.count},     {"median_ms", s.median_ms},
+          {"p95_ms", s.p95_ms},   {"max_ms", s.max_ms},
+          {"mean_ms", s.mean_ms}, {"total_s", s.mean_ms * static_cast<double>(s.count) * 1e-3}};
+}
+
 }  // namespace featsense::app

@@ -2,6 +2,8 @@
 // Per-stage timings in milliseconds and their summary (median / p95 / max), as every
 // report and benchmark prints them.
 
+#include <nlohmann/json.hpp>
+
 #include <cstddef>
 #include <vector>
 
@@ -17,5 +19,8 @@ struct TimingSummary {
 
 /// Summary of samples in milliseconds (p95 by the nearest-rank method).
 TimingSummary summarize_ms(std::vector<double> samples_ms);
+
+/// The summary as reports print it: count, median_ms, p95_ms, max_ms, mean_ms, total_s.
+nlohmann::json timing_json(const std::vector<double>& samples_ms);
 
 }  // namespace featsense::app

@@ -211,6 +211,21 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
   // A sensor moving through a furnished room at walking speed, range noise on: the path
   // within a few centimetres of the truth after 1.1 s.
   EXPECT_LT(report["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05) << report["eval"].dump(2);
+  for (const char* stage : {"features", "registration"}) {
+    EXPECT_EQ(report["odometry"]["timings"][stage]["count"].get<size_t>(), 12u) << stage;
+    EXPECT_GT(report["odometry"]["timings"][stage]["median_ms"].get<double>(), 0.0) << stage;
+  }
+
+  // A reference trajectory of the user's: the path is compared with it (after alignment).
+  const fs::path other = scratch_dir("cli_map_odometry") / "reference";
+  const CommandResult referenced =
+      run_featsense("map " + sequence() + " -o " + other.string() + " --end 5" + kSmallMap +
+                    " --no-mesh --reference-trajectory " + gt());
+  ASSERT_EQ(referenced.exit_code, 0) << referenced.output;
+  const nlohmann::json second = nlohmann::json::parse(std::ifstream(other / "report.json"));
+  ASSERT_TRUE(second["eval"].contains("traj")) << second.dump(2);
+  EXPECT_EQ(second["eval"]["traj"]["ape"]["count"].get<size_t>(), 6u);
+  EXPECT_LT(second["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);
 }
 
 TEST_F(CliMap, BadInputGivesOneClearError) {

@@ -1,5 +1,6 @@
 #include "featsense/slam/odometry/odometry_locator.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -15,6 +16,10 @@ namespace {
 /// The fraction `s` of a rigid motion at constant velocity (negative: before it began).
 Eigen::Isometry3d part_of(const Eigen::Isometry3d& motion, double s) {
   return interpolate_pose(Eigen::Isometry3d::Identity(), motion, s);
+}
+
+double milliseconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
 }
 
 /// The mean of `times` (seconds after the stamp), 0 when empty.
@@ -33,7 +38,9 @@ class FeatureOdometryLocator final : public OdometryLocator {
       : features_(features), odometry_(odometry), deskew_(deskew), T_map_first_(T_map_first) {}
 
   std::optional<ScanPlacement> locate(const Scan& scan, std::string& why) override {
+    const auto start = std::chrono::steady_clock::now();
     const FeatureSet found = features::extract_features(scan, features_);
+    const auto extracted = std::chrono::steady_clock::now();
     // With odometry.deskew the registration deskews the features with the motion it is
     // estimating for this scan (FeatureOdometry) and gives the pose at the stamp. Without it
     // the features are registered as measured, over the whole sweep: the pose that fits them
@@ -41,6 +48,8 @@ class FeatureOdometryLocator final : public OdometryLocator {
     // the motion between the scans. (Deskewing the features with the last scan's motion
     // before registration fed each motion error into the next estimate and made it oscillate.)
     const OdometryResult result = odometry_.register_scan(found);
+    counts_.features_ms.push_back(milliseconds(extracted - start));
+    counts_.registration_ms.push_back(milliseconds(std::chrono::steady_clock::now() - extracted));
     ++counts_.scans;
     counts_.features_sum += static_cast<double>(found.size());
     if (found.intensity_confirmed) ++counts_.intensity_confirmed_scans;

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include "featsense/config/config.hpp"
 #include "featsense/slam/scan_locator.hpp"
@@ -19,7 +20,9 @@ struct OdometryCounts {
   size_t degenerate_scans = 0;  ///< a direction of motion held at the prediction
   size_t failed_scans = 0;      ///< the pose is the prediction (the reason is logged)
   size_t intensity_confirmed_scans = 0;
-  double features_sum = 0.0;  ///< edge + surface points, summed over scans
+  double features_sum = 0.0;            ///< edge + surface points, summed over scans
+  std::vector<double> features_ms;      ///< per scan: the feature extraction
+  std::vector<double> registration_ms;  ///< per scan: the registration and the map update
 };
 
 class OdometryLocator : public ScanLocator {
