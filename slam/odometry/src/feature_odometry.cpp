@@ -94,8 +94,6 @@ Eigen::Isometry3d FeatureOdometry::restart_map(const TimedFeatures& raw,
     const RegistrationStart from_best{best, start.previous, start.elapsed_s};
     const Eigen::Isometry3d refined = register_to_map(*map_, raw, from_best, settings_, again);
     if (!again.diagnostics.converged) break;  // the restarted map holds the first scan anyway
-    again.timing.association_ms += result.timing.association_ms;
-    again.timing.solve_ms += result.timing.solve_ms;
     result = again;
     const bool done = settled(best, refined, kRestartSettledM);
     best = refined;
