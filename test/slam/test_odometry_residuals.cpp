@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <random>
 
 #include "featsense/slam/odometry/degeneracy.hpp"
 #include "featsense/slam/odometry/feature_fit.hpp"
+#include "featsense/slam/odometry/huber_folding.hpp"
 #include "featsense/slam/odometry/point_residuals.hpp"
 #include "featsense/slam/odometry/voxel_filter.hpp"
 
@@ -100,6 +102,57 @@ TEST(OdometryResiduals, ACoupledPointMovesGainTimesAsFarAsTheRigidOne) {
   const double rigid_change = residual_at(rigid, q1, t1)(0) - residual_at(rigid, q0, t0)(0);
   const double coupled_change = residual_at(coupled, q1, t1)(0) - residual_at(coupled, q0, t0)(0);
   EXPECT_NEAR(coupled_change, 1.75 * rigid_change, 1e-12);
+}
+
+/// Huber's rho(s) as Ceres' HuberLoss defines it.
+double huber_rho(double s, double delta) {
+  return s <= delta * delta ? s : 2.0 * delta * std::sqrt(s) - delta * delta;
+}
+
+TEST(OdometryHuberFolding, SameCostAndGradientAsTheLossAndExactJacobians) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto vec = [&] { return Eigen::Vector3d(u(rng), u(rng), u(rng)); };
+  const double delta = 0.1;
+  for (int trial = 0; trial < 40; ++trial) {
+    PointToLine line{10.0 * vec(), 3.0 * vec(), vec().normalized()};
+    line.anchor = 10.0 * vec();
+    line.gain = 1.3;
+    const Eigen::Quaterniond q = Eigen::Quaterniond::UnitRandom();
+    // Near and far from the line: both sides of the loss's kink.
+    const Eigen::Vector3d t = (trial % 2 == 0 ? 0.02 : 2.0) * vec();
+    auto folded = [&](const Eigen::Quaterniond& qq, const Eigen::Vector3d& tt,
+                      Eigen::Matrix<double, 3, 4, Eigen::RowMajor>* jq,
+                      Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* jt) {
+      Eigen::Vector3d r;
+      line.evaluate(qq.coeffs().data(), tt.data(), r.data(), jq ? jq->data() : nullptr,
+                    jt ? jt->data() : nullptr);
+      fold_huber(delta, 3, r.data(), jq ? jq->data() : nullptr, jt ? jt->data() : nullptr);
+      return r;
+    };
+    Eigen::Vector3d raw;
+    Eigen::Matrix<double, 3, 4, Eigen::RowMajor> raw_jq;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> raw_jt;
+    line.evaluate(q.coeffs().data(), t.data(), raw.data(), raw_jq.data(), raw_jt.data());
+    Eigen::Matrix<double, 3, 4, Eigen::RowMajor> jq;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> jt;
+    const Eigen::Vector3d r = folded(q, t, &jq, &jt);
+    const double s = raw.squaredNorm();
+    // The same cost ...
+    EXPECT_NEAR(r.squaredNorm(), huber_rho(s, delta), 1e-12);
+    // ... the same gradient, rho'(s) J^T r ...
+    const double rho1 = s <= delta * delta ? 1.0 : delta / std::sqrt(s);
+    EXPECT_LT((jt.transpose() * r - rho1 * raw_jt.transpose() * raw).norm(), 1e-9);
+    EXPECT_LT((jq.transpose() * r - rho1 * raw_jq.transpose() * raw).norm(), 1e-9);
+    // ... and the Jacobian of the folded residual, by central differences in t.
+    const double h = 1e-7;
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(i);
+      const Eigen::Vector3d numeric =
+          (folded(q, t + e, nullptr, nullptr) - folded(q, t - e, nullptr, nullptr)) / (2 * h);
+      EXPECT_LT((numeric - jt.col(i)).norm(), 1e-6) << trial;
+    }
+  }
 }
 
 TEST(OdometryResiduals, DistancesAreThoseOfTheGeometry) {

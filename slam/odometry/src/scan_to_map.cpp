@@ -13,6 +13,7 @@
 
 #include "featsense/slam/odometry/degeneracy.hpp"
 #include "featsense/slam/odometry/feature_fit.hpp"
+#include "featsense/slam/odometry/huber_folding.hpp"
 #include "featsense/slam/odometry/point_residuals.hpp"
 
 namespace featsense::slam::odometry {
@@ -25,21 +26,51 @@ constexpr size_t kMinCorrespondences = 10;
 /// range noise, and small enough that the errors it leaves do not add up over a run.
 constexpr double kSettledMoveM = 1e-4;
 
+/// Residuals per Ceres cost function: Ceres' overhead per block (a virtual call, the loss, a
+/// Jacobian block written into the problem's matrix) costs more than a residual itself.
+constexpr size_t kResidualsPerBlock = 64;
+
+/// `count` residuals from `first` on, each under Huber's loss (folded in, huber_folding.hpp).
 template <class Residual>
-class CostFunction final : public ceres::SizedCostFunction<Residual::kResiduals, 4, 3> {
+class RobustBatchCost final : public ceres::CostFunction {
  public:
-  explicit CostFunction(const Residual& residual) : residual_(residual) {}
+  RobustBatchCost(const Residual* first, size_t count, double huber)
+      : first_(first), count_(count), huber_(huber) {
+    set_num_residuals(static_cast<int>(count * Residual::kResiduals));
+    mutable_parameter_block_sizes()->assign({4, 3});
+  }
+
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    residual_.evaluate(parameters[0], parameters[1], residuals,
-                       jacobians != nullptr ? jacobians[0] : nullptr,
-                       jacobians != nullptr ? jacobians[1] : nullptr);
+    constexpr int rows = Residual::kResiduals;
+    double* jq = jacobians != nullptr ? jacobians[0] : nullptr;
+    double* jt = jacobians != nullptr ? jacobians[1] : nullptr;
+    for (size_t i = 0; i < count_; ++i) {
+      double* r = residuals + i * rows;
+      double* q_rows = jq != nullptr ? jq + i * rows * 4 : nullptr;
+      double* t_rows = jt != nullptr ? jt + i * rows * 3 : nullptr;
+      first_[i].evaluate(parameters[0], parameters[1], r, q_rows, t_rows);
+      fold_huber(huber_, rows, r, q_rows, t_rows);
+    }
     return true;
   }
 
  private:
-  Residual residual_;
+  const Residual* first_;
+  size_t count_;
+  double huber_;
 };
+
+/// Adds `residuals` to the problem in blocks of kResidualsPerBlock (they must outlive it).
+template <class Residual>
+void add_batched(ceres::Problem& problem, const std::vector<Residual>& residuals, double huber,
+                 double* q, double* t) {
+  for (size_t begin = 0; begin < residuals.size(); begin += kResidualsPerBlock) {
+    const size_t count = std::min(kResidualsPerBlock, residuals.size() - begin);
+    problem.AddResidualBlock(new RobustBatchCost<Residual>(&residuals[begin], count, huber),
+                             nullptr, q, t);
+  }
+}
 
 struct Correspondences {
   std::vector<PointToLine> lines;
@@ -195,13 +226,8 @@ Eigen::Isometry3d solve(const Correspondences& c, const Eigen::Isometry3d& pose,
   ceres::Problem problem(problem_options);
   problem.AddParameterBlock(q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
   problem.AddParameterBlock(t.data(), 3);
-  auto* loss = new ceres::HuberLoss(settings.huber_loss_m);
-  for (const PointToLine& l : c.lines) {
-    problem.AddResidualBlock(new CostFunction<PointToLine>(l), loss, q.coeffs().data(), t.data());
-  }
-  for (const PointToPlane& p : c.planes) {
-    problem.AddResidualBlock(new CostFunction<PointToPlane>(p), loss, q.coeffs().data(), t.data());
-  }
+  add_batched(problem, c.lines, settings.huber_loss_m, q.coeffs().data(), t.data());
+  add_batched(problem, c.planes, settings.huber_loss_m, q.coeffs().data(), t.data());
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   options.max_num_iterations = settings.solver_iterations;
