@@ -60,10 +60,10 @@ class VoxelMap {
     }
   }
 
-  std::vector<Eigen::Vector3d> nearest(const Eigen::Vector3d& query, int k,
-                                       double max_distance) const {
-    std::vector<Eigen::Vector3d> found;
-    if (tree_ == nullptr || k <= 0) return found;
+  void nearest(const Eigen::Vector3d& query, int k, double max_distance,
+               std::vector<Eigen::Vector3d>& found) const {
+    found.clear();
+    if (tree_ == nullptr || k <= 0) return;
     std::array<uint32_t, 16> index{};
     std::array<float, 16> distance2{};
     const size_t want = std::min<size_t>(static_cast<size_t>(k), index.size());
@@ -74,7 +74,6 @@ class VoxelMap {
       if (distance2[i] > max2) break;
       found.push_back(cloud_.points[index[i]].cast<double>());
     }
-    return found;
   }
 
   size_t size() const { return cloud_.points.size(); }
@@ -111,14 +110,14 @@ void LocalFeatureMap::add(const std::vector<Eigen::Vector3f>& edges,
   }
 }
 
-std::vector<Eigen::Vector3d> LocalFeatureMap::nearest_edges(const Eigen::Vector3d& query, int k,
-                                                            double max_distance_m) const {
-  return impl_->edges.nearest(query, k, max_distance_m);
+void LocalFeatureMap::nearest_edges(const Eigen::Vector3d& query, int k, double max_distance_m,
+                                    std::vector<Eigen::Vector3d>& found) const {
+  impl_->edges.nearest(query, k, max_distance_m, found);
 }
 
-std::vector<Eigen::Vector3d> LocalFeatureMap::nearest_surfaces(const Eigen::Vector3d& query, int k,
-                                                               double max_distance_m) const {
-  return impl_->surfaces.nearest(query, k, max_distance_m);
+void LocalFeatureMap::nearest_surfaces(const Eigen::Vector3d& query, int k, double max_distance_m,
+                                       std::vector<Eigen::Vector3d>& found) const {
+  impl_->surfaces.nearest(query, k, max_distance_m, found);
 }
 
 size_t LocalFeatureMap::edge_count() const { return impl_->edges.size(); }

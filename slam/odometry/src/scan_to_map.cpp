@@ -78,7 +78,7 @@ struct Correspondences {
   size_t size() const { return lines.size() + planes.size(); }
 };
 
-/// The correspondences of `points` at pose T: `search` gives a map point's neighbours, `make`
+/// The correspondences of `points` at pose T: `search` finds a map point's neighbours, `make`
 /// the residual of a fitted line or plane (or nothing). A point measured `times[i]` after the
 /// stamp moves (1 + times[i] / period_s) times as far as the pose (point_residuals.hpp); with
 /// period_s 0 the points are rigid.
@@ -90,10 +90,12 @@ std::vector<Residual> match(const std::vector<Eigen::Vector3f>& points,
   std::vector<std::optional<Residual>> found(points.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
                     [&](const tbb::blocked_range<size_t>& range) {
+                      std::vector<Eigen::Vector3d> near;
+                      near.reserve(kNeighbours);
                       for (size_t i = range.begin(); i < range.end(); ++i) {
                         const Eigen::Vector3d p = points[i].cast<double>();
                         const Eigen::Vector3d x = T * p;
-                        const std::vector<Eigen::Vector3d> near = search(x);
+                        search(x, near);
                         if (near.size() != static_cast<size_t>(kNeighbours)) continue;
                         found[i] = make(p, near);
                         if (found[i] && period_s > 0.0) {
@@ -114,7 +116,9 @@ Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& point
   Correspondences c;
   c.lines = match<PointToLine>(
       points.edges, points.edge_time_s, period_s, T,
-      [&](const Eigen::Vector3d& x) { return map.nearest_edges(x, kNeighbours, max_distance); },
+      [&](const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& near) {
+        map.nearest_edges(x, kNeighbours, max_distance, near);
+      },
       [](const Eigen::Vector3d& p,
          const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToLine> {
         const auto line = fit_line(near);
@@ -127,7 +131,9 @@ Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& point
       });
   c.planes = match<PointToPlane>(
       points.surfaces, points.surface_time_s, period_s, T,
-      [&](const Eigen::Vector3d& x) { return map.nearest_surfaces(x, kNeighbours, max_distance); },
+      [&](const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& near) {
+        map.nearest_surfaces(x, kNeighbours, max_distance, near);
+      },
       [](const Eigen::Vector3d& p,
          const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
         const auto plane = fit_plane(near);

@@ -26,11 +26,12 @@ class LocalFeatureMap {
            const Eigen::Isometry3d& T_map_sensor);
 
   /// The k nearest edge (surface) points of `query` that lie within `max_distance_m`, nearest
-  /// first; fewer when the map has fewer there.
-  std::vector<Eigen::Vector3d> nearest_edges(const Eigen::Vector3d& query, int k,
-                                             double max_distance_m) const;
-  std::vector<Eigen::Vector3d> nearest_surfaces(const Eigen::Vector3d& query, int k,
-                                                double max_distance_m) const;
+  /// first, into `found` (cleared first; the caller's buffer, so that searches allocate
+  /// nothing); fewer when the map has fewer there.
+  void nearest_edges(const Eigen::Vector3d& query, int k, double max_distance_m,
+                     std::vector<Eigen::Vector3d>& found) const;
+  void nearest_surfaces(const Eigen::Vector3d& query, int k, double max_distance_m,
+                        std::vector<Eigen::Vector3d>& found) const;
 
   size_t edge_count() const;
   size_t surface_count() const;
