@@ -13,8 +13,10 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
+#include "map_report.hpp"
 #include "simulate_job.hpp"
 #include "source_options.hpp"
 #include "timing_stats.hpp"
@@ -27,74 +29,101 @@ using Clock = std::chrono::steady_clock;
 struct BenchFrontEndOptions {
   std::string scene = "parking";
   std::string path = "drive";
+  std::string trajectory_file;  ///< TUM sensor poses for the simulation instead of --path
+  std::string estimate_out;     ///< bench odometry: the estimated poses, TUM
   InputOptions input;
   int scans = 100;
   std::optional<std::string> json_path;
 };
 
-/// The benchmark's scans, and the truth at their stamps where they were simulated.
-struct FrontEndScans {
-  std::vector<slam::Scan> scans;
-  std::optional<slam::Trajectory> truth;
-  std::string description;
-};
-
-FrontEndScans load_scans(const BenchFrontEndOptions& options, const config::Config& config) {
-  FrontEndScans out;
-  if (!options.input.input.empty()) {
-    std::unique_ptr<slam::ScanSource> source = options.input.open(config);
-    out.description = source->info().format + " " + options.input.input;
-    while (static_cast<int>(out.scans.size()) < options.scans) {
-      std::optional<slam::Scan> scan = source->next();
-      if (!scan) break;
-      out.scans.push_back(std::move(*scan));
+/// The benchmark's scans, one at a time: a recording's, or a simulation's made frame by frame
+/// outside the timed stages, so that a long sequence needs no memory of its own (the peak
+/// RSS is the front end's). The truth at their stamps where they were simulated.
+class BenchScans {
+ public:
+  BenchScans(const BenchFrontEndOptions& options, const config::Config& config)
+      : limit_(static_cast<uint64_t>(options.scans)) {
+    if (!options.input.input.empty()) {
+      recording_ = options.input.open(config);
+      description_ = recording_->info().format + " " + options.input.input;
+      return;
     }
-    if (out.scans.empty()) throw slam::InputError(options.input.input + ": no readable frame");
-    return out;
+    SimulateOptions simulate;
+    simulate.scene = options.scene;
+    simulate.path = options.trajectory_file.empty() ? options.path : "";
+    simulate.trajectory_file = options.trajectory_file;
+    simulate.frames = options.scans;
+    simulation_ = std::make_unique<PreparedSimulation>(simulate);
+    truth_ = simulation_->frame_poses();
+    description_ = "simulated " + options.scene + " scene, " +
+                   (options.trajectory_file.empty() ? options.path + " path"
+                                                    : "path " + options.trajectory_file) +
+                   ", " + simulation_->simulator->settings().sensor.name;
   }
-  SimulateOptions simulate;
-  simulate.scene = options.scene;
-  simulate.path = options.path;
-  simulate.frames = options.scans;
-  const PreparedSimulation simulation(simulate);
-  for (uint64_t frame = 0; frame < simulation.frames; ++frame) {
-    slam::SimulatedFrame simulated = simulation.simulator->simulate(frame);
-    simulated.scan.sequence = frame;
-    out.scans.push_back(std::move(simulated.scan));
+
+  std::optional<slam::Scan> next() {
+    if (count_ >= limit_) return std::nullopt;
+    std::optional<slam::Scan> scan;
+    if (recording_) {
+      scan = recording_->next();
+    } else if (count_ < simulation_->frames) {
+      scan = std::move(simulation_->simulator->simulate(count_).scan);
+      scan->sequence = count_;
+    }
+    if (!scan) return std::nullopt;
+    if (count_ == 0) {
+      rows_ = scan->rows;
+      cols_ = scan->cols;
+    }
+    ++count_;
+    return scan;
   }
-  out.truth = simulation.frame_poses();
-  out.description = "simulated " + options.scene + " scene, " + options.path + " path, " +
-                    simulation.simulator->settings().sensor.name;
-  return out;
-}
+
+  /// Throws InputError when the source gave no scan at all.
+  void check_read(const std::string& input) const {
+    if (count_ == 0) throw slam::InputError(input + ": no readable frame");
+  }
+
+  const std::optional<slam::Trajectory>& truth() const { return truth_; }
+
+  nlohmann::json json(const char* benchmark) const {
+    return {{"benchmark", benchmark},
+            {"scans", description_},
+            {"sequence_scans", count_},
+            {"rows", rows_},
+            {"cols", cols_}};
+  }
+
+ private:
+  std::unique_ptr<slam::ScanSource> recording_;
+  std::unique_ptr<PreparedSimulation> simulation_;
+  std::optional<slam::Trajectory> truth_;
+  std::string description_;
+  uint64_t limit_;
+  uint64_t count_ = 0;
+  int rows_ = 0;
+  int cols_ = 0;
+};
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-nlohmann::json common_json(const char* name, const FrontEndScans& scans,
-                           const slam::features::FeatureSettings& settings) {
-  const slam::Scan& first = scans.scans.front();
-  return {{"benchmark", name},
-          {"scans", scans.description},
-          {"sequence_scans", scans.scans.size()},
-          {"rows", first.rows},
-          {"cols", first.cols},
-          {"intensity_fusion", settings.intensity_fusion}};
-}
-
 nlohmann::json run_bench_features(const BenchFrontEndOptions& options, const CliContext& context) {
   const config::Config config = context.load_config({});
-  const FrontEndScans scans = load_scans(options, config);
+  BenchScans scans(options, config);
   const slam::features::FeatureSettings settings = slam::features::from_config(config);
-  slam::features::extract_features(scans.scans.front(), settings);  // warm-up: first allocations
 
   std::vector<double> total, curvature, selection, intensity, edges, surfaces, edges_geometric;
   size_t confirmed = 0;
-  for (const slam::Scan& scan : scans.scans) {
+  bool warmed_up = false;
+  while (const std::optional<slam::Scan> scan = scans.next()) {
+    // The first scan warms up (the first allocations) and is extracted twice.
+    if (!warmed_up) slam::features::extract_features(*scan, settings);
+    warmed_up = true;
     slam::features::FeatureStats stats;
     const auto start = Clock::now();
-    slam::features::extract_features(scan, settings, &stats);
+    slam::features::extract_features(*scan, settings, &stats);
     total.push_back(ms_since(start));
     curvature.push_back(stats.curvature_ms);
     selection.push_back(stats.selection_ms);
@@ -104,7 +133,9 @@ nlohmann::json run_bench_features(const BenchFrontEndOptions& options, const Cli
     surfaces.push_back(static_cast<double>(stats.surfaces));
     if (stats.intensity_confirmed) ++confirmed;
   }
-  nlohmann::json result = common_json("features", scans, settings);
+  scans.check_read(options.input.input);
+  nlohmann::json result = scans.json("features");
+  result["intensity_fusion"] = settings.intensity_fusion;
   result.update(timing_json(total));
   result["stages_median_ms"] = {{"curvature", summarize_ms(curvature).median_ms},
                                 {"selection", summarize_ms(selection).median_ms},
@@ -118,7 +149,7 @@ nlohmann::json run_bench_features(const BenchFrontEndOptions& options, const Cli
 
 nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const CliContext& context) {
   const config::Config config = context.load_config({});
-  const FrontEndScans scans = load_scans(options, config);
+  BenchScans scans(options, config);
   const slam::features::FeatureSettings settings = slam::features::from_config(config);
   slam::odometry::FeatureOdometry odometry(slam::odometry::from_config(config));
 
@@ -127,15 +158,19 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   double startup_ms = 0.0;
   size_t degenerate = 0, failed = 0;
   slam::Trajectory estimate;
-  for (size_t i = 0; i < scans.scans.size(); ++i) {
+  slam::odometry::OdometryResult last;
+  for (size_t i = 0;; ++i) {
+    const std::optional<slam::Scan> scan = scans.next();
+    if (!scan) break;
     const auto start = Clock::now();
-    const slam::FeatureSet found = slam::features::extract_features(scans.scans[i], settings);
+    const slam::FeatureSet found = slam::features::extract_features(*scan, settings);
     const auto extracted = Clock::now();
     const slam::odometry::OdometryResult result = odometry.register_scan(found);
     const double registration = ms_since(extracted);
     const double features = std::chrono::duration<double, std::milli>(extracted - start).count();
-    estimate.stamps_ns.push_back(scans.scans[i].stamp_ns);
+    estimate.stamps_ns.push_back(scan->stamp_ns);
     estimate.poses.push_back(result.T_map_sensor);
+    last = result;
     if (result.diagnostics.degenerate) ++degenerate;
     if (i > 0 && !result.diagnostics.converged) ++failed;
     // The first scan only starts the map, the second restarts it with the first deskewed once
@@ -152,7 +187,9 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
     total_ms.push_back(features + registration);
     feature_counts.push_back(static_cast<double>(found.size()));
   }
-  nlohmann::json result = common_json("odometry", scans, settings);
+  scans.check_read(options.input.input);
+  nlohmann::json result = scans.json("odometry");
+  result["intensity_fusion"] = settings.intensity_fusion;
   result["timed_scans"] = total_ms.size();
   result["startup_ms"] = startup_ms;
   result["optimization_steps"] = config.odometry.optimization_steps;
@@ -167,11 +204,22 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   result["features_per_scan"] = min_median_max(feature_counts);
   result["degenerate_scans"] = degenerate;
   result["failed_scans"] = failed;
-  if (scans.truth && estimate.size() >= 2) {
-    const slam::TrajectoryEvaluation e = slam::evaluate_trajectory(estimate, *scans.truth);
-    result["ape_rmse_m"] = e.ape.rmse;
-    result["rpe_translation_rmse_m"] = e.rpe_translation.rmse;
-    result["path_length_m"] = e.ground_truth_length_m;
+  // The local feature map is bounded (odometry.map_radius): memory stays flat however long
+  // the run.
+  result["map_points"] = {{"edges", last.map_edges}, {"surfaces", last.map_surfaces}};
+  result["peak_rss_mb"] = peak_rss_mb();
+  if (!options.estimate_out.empty()) slam::write_tum(estimate, options.estimate_out);
+  if (scans.truth() && estimate.size() >= 2) {
+    try {
+      const slam::TrajectoryEvaluation e = slam::evaluate_trajectory(estimate, *scans.truth());
+      result["ape_rmse_m"] = e.ape.rmse;
+      result["rpe_translation_rmse_m"] = e.rpe_translation.rmse;
+      result["path_length_m"] = e.ground_truth_length_m;
+      if (e.kitti) result["kitti_translation_drift_percent"] = e.kitti->t_err_pct;
+    } catch (const slam::TrajectoryError& e) {
+      // A straight path leaves the alignment undetermined: no figures, and why.
+      result["trajectory_evaluation_error"] = e.what();
+    }
   }
   return result;
 }
@@ -185,6 +233,10 @@ Command add_front_end_bench(CLI::App& bench, const char* name, const char* help,
       ->capture_default_str();
   command->add_option("--path", options->path, "Simulated path (see `featsense simulate`)")
       ->capture_default_str();
+  command
+      ->add_option("--trajectory", options->trajectory_file,
+                   "TUM file of sensor poses to simulate instead of --path")
+      ->check(CLI::ExistingFile);
   command->add_option("--input", options->input.input,
                       "Use the first frames of this recording instead");
   command->add_option("--meta", options->input.meta_path, "Ouster metadata JSON for --input");
@@ -194,6 +246,10 @@ Command add_front_end_bench(CLI::App& bench, const char* name, const char* help,
       ->check(CLI::Range(3, 100000))
       ->capture_default_str();
   command->add_option("--json", options->json_path, "Write the JSON here too ('-' = stdout only)");
+  if (std::string(name) == "odometry") {
+    command->add_option("--trajectory-out", options->estimate_out,
+                        "Write the estimated poses here (TUM)");
+  }
   return {command, [options, run, &context] {
             print_bench_result(run(*options, context), options->json_path);
           }};
