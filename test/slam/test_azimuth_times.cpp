@@ -1,18 +1,24 @@
 // Per-point times from the azimuth for clouds without a time field: firing order and ring
 // by ring, the seam from the first points, the stamp's reference (sweep start or KITTI's
-// forward-facing instant), and clouds whose order tells no times.
+// forward-facing instant), clouds whose order tells no times, and the readers that use them.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
 
+#include "common/test_data.hpp"
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/slam/io/azimuth_times.hpp"
+#include "featsense/slam/io/cloud_files.hpp"
+#include "featsense/slam/io/readers.hpp"
 
 namespace featsense::slam {
 namespace {
+
+namespace fs = std::filesystem;
 
 constexpr double kRateHz = 10.0;
 constexpr double kDeg = M_PI / 180.0;
@@ -217,6 +223,184 @@ TEST(AzimuthTimes, PointsOutOfOrderTellNoTimes) {
   const std::vector<Eigen::Vector3f> few(cloud.xyz.begin(), cloud.xyz.begin() + 20);
   EXPECT_NE(azimuth_times(few, kRateHz, SweepReference::kSweepStart).problem.find("too few"),
             std::string::npos);
+}
+
+/// An unorganized cloud as a file without a time field would decode.
+DecodedCloud decoded_of(std::vector<Eigen::Vector3f> xyz) {
+  DecodedCloud decoded;
+  decoded.format = "pcd";
+  decoded.width = static_cast<int>(xyz.size());
+  decoded.fields = {"x", "y", "z"};
+  decoded.cloud.xyz = std::move(xyz);
+  return decoded;
+}
+
+/// The largest |scan time - known| over the scan's valid cells, `known` per cell.
+double largest_cell_error_s(const Scan& scan, const std::vector<double>& known_by_cell) {
+  double largest = 0.0;
+  for (size_t i = 0; i < scan.size(); ++i) {
+    if (scan.valid[i]) {
+      largest = std::max(largest, std::abs(scan.time_offset_s[i] - known_by_cell[i]));
+    }
+  }
+  return largest;
+}
+
+/// Per cell of `sensor`'s scan, the time of the point of `cloud` that organize() puts there:
+/// a sweep()'s points lie on their beams, each in the column of its azimuth.
+std::vector<double> times_by_cell(const TimedCloud& cloud, const config::SensorModel& sensor) {
+  std::vector<double> by_cell(static_cast<size_t>(sensor.beams * sensor.columns), 0.0);
+  for (size_t i = 0; i < cloud.xyz.size(); ++i) {
+    const int col = column_of(cloud.xyz[i], sensor.columns);
+    by_cell[static_cast<size_t>(cloud.beam[i] * sensor.columns + col)] = cloud.time_s[i];
+  }
+  return by_cell;
+}
+
+TEST(AzimuthTimes, CloudToScanDerivesKeepsOrReportsTimes) {
+  const config::SensorModel vlp16 = config::sensor_preset("vlp16");
+  SweepSpec spec;
+  spec.sensor = vlp16;
+  spec.seam_rad = 30.0 * kDeg;
+  const TimedCloud cloud = sweep(spec);
+  const std::vector<double> known = times_by_cell(cloud, vlp16);
+
+  // No time field: from the azimuth.
+  std::vector<std::string> warnings;
+  std::string times;
+  Scan scan = cloud_to_scan(decoded_of(cloud.xyz), vlp16, "a.pcd", nullptr, &warnings, {}, &times);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(times.rfind("from the azimuth (the sweep began 30.0 deg", 0), 0u) << times;
+  EXPECT_LE(largest_cell_error_s(scan, known), column_s(vlp16));
+
+  // A time field of its own wins, even where it disagrees with the azimuth.
+  DecodedCloud timed = decoded_of(cloud.xyz);
+  timed.fields.push_back("time");
+  for (const double t : cloud.time_s)
+    timed.cloud.time_offset_s.push_back(static_cast<float>(t / 2));
+  scan = cloud_to_scan(timed, vlp16, "b.pcd", nullptr, &warnings, {}, &times);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(times, "per-point field 'time'");
+  std::vector<double> halved = known;
+  for (double& t : halved) t /= 2;
+  EXPECT_LE(largest_cell_error_s(scan, halved), 1e-7);
+
+  // Shuffled: no times, a warning, and the report says why.
+  std::vector<Eigen::Vector3f> shuffled = cloud.xyz;
+  std::shuffle(shuffled.begin() + 16, shuffled.end(), std::mt19937(5));
+  scan = cloud_to_scan(decoded_of(shuffled), vlp16, "c.pcd", nullptr, &warnings, {}, &times);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].rfind("c.pcd: no per-point times from the azimuth: the points are not in "
+                              "the order they were measured",
+                              0),
+            0u)
+      << warnings[0];
+  EXPECT_EQ(times.rfind("none: the points are not in the order", 0), 0u) << times;
+  EXPECT_EQ(std::count(scan.time_offset_s.begin(), scan.time_offset_s.end(), 0.0f),
+            static_cast<std::ptrdiff_t>(scan.size()));
+
+  // sensor.times_from_azimuth: false.
+  warnings.clear();
+  CloudTiming off;
+  off.from_azimuth = false;
+  scan = cloud_to_scan(decoded_of(cloud.xyz), vlp16, "d.pcd", nullptr, &warnings, off, &times);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(times, "none: no time field, and sensor.times_from_azimuth is false");
+  EXPECT_EQ(std::count(scan.time_offset_s.begin(), scan.time_offset_s.end(), 0.0f),
+            static_cast<std::ptrdiff_t>(scan.size()));
+}
+
+TEST(AzimuthTimes, OrganizedCloudWithoutTimesIsReadRowByRow) {
+  // An organized range image stores its rows one after another: ring by ring from column 0.
+  const config::SensorModel vlp16 = config::sensor_preset("vlp16");
+  DecodedCloud decoded;
+  decoded.format = "pcd";
+  decoded.height = vlp16.beams;
+  decoded.width = vlp16.columns;
+  decoded.fields = {"x", "y", "z"};
+  for (int row = 0; row < vlp16.beams; ++row) {
+    for (int col = 0; col < vlp16.columns; ++col) {
+      const bool hole = (row * 31 + col) % 10 == 0;
+      decoded.cloud.xyz.push_back(
+          hole ? Eigen::Vector3f::Zero()
+               : point_at(2.0 * M_PI * col / vlp16.columns, vlp16.elevation_rad[row], 8.0));
+    }
+  }
+  std::string times;
+  const Scan scan = cloud_to_scan(decoded, vlp16, "o.pcd", nullptr, nullptr, {}, &times);
+  EXPECT_NE(times.find("16 rings one after another"), std::string::npos) << times;
+  std::vector<double> known(scan.size());
+  for (size_t i = 0; i < scan.size(); ++i) known[i] = column_s(vlp16) * (i % vlp16.columns);
+  EXPECT_LE(largest_cell_error_s(scan, known), 1e-6);
+}
+
+void write_bin(const fs::path& path, const std::vector<Eigen::Vector3f>& xyz) {
+  std::ofstream out(path, std::ios::binary);
+  for (const Eigen::Vector3f& p : xyz) {
+    const float record[4] = {p.x(), p.y(), p.z(), 0.5f};
+    out.write(reinterpret_cast<const char*>(record), sizeof record);
+  }
+}
+
+std::vector<Scan> read_all(ScanSource& source) {
+  std::vector<Scan> scans;
+  while (std::optional<Scan> scan = source.next()) scans.push_back(std::move(*scan));
+  return scans;
+}
+
+TEST(AzimuthTimes, KittiSequenceTimesCountFromFacingForward) {
+  // KITTI's layout: sequences/00/times.txt beside sequences/00/velodyne/*.bin, points ring
+  // by ring from behind the car.
+  const fs::path sequence = test::scratch_dir("azimuth_times_kitti");
+  const fs::path velodyne = sequence / "velodyne";
+  fs::create_directories(velodyne);
+  SweepSpec spec;
+  spec.sensor = config::sensor_preset("hdl64");
+  // Behind the sensor, on a column's centre: the scan's cells hold one point each.
+  const int seam_col = (spec.sensor.columns + 1) / 2;
+  spec.seam_rad = 2.0 * M_PI * seam_col / spec.sensor.columns;
+  spec.ring_by_ring = true;
+  const TimedCloud cloud = sweep(spec);
+  const std::vector<double> known = times_by_cell(cloud, spec.sensor);
+  const double half_s = column_s(spec.sensor) * (spec.sensor.columns - seam_col);
+  for (int n = 0; n < 2; ++n)
+    write_bin(velodyne / ("00000" + std::to_string(n) + ".bin"), cloud.xyz);
+  std::ofstream(sequence / "times.txt") << "0.000000e+00\n1.036592e-01\n";
+
+  const auto source = open_scan_folder(velodyne.string(), {});
+  EXPECT_NE(source->info().times.find("0 s where the sensor faced +x"), std::string::npos)
+      << source->info().times;
+  std::vector<Scan> scans = read_all(*source);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[1].stamp_ns, 103659200);
+  for (const Scan& scan : scans) {
+    EXPECT_LE(largest_cell_error_s(scan, shifted(known, half_s)), column_s(spec.sensor));
+  }
+  EXPECT_EQ(source->stats().warning_count, 0u);
+
+  // Without times.txt the stamps are the sweeps' starts.
+  fs::remove(sequence / "times.txt");
+  const auto unstamped = open_scan_folder(velodyne.string(), {});
+  EXPECT_NE(unstamped->info().times.find("0 s where it began"), std::string::npos)
+      << unstamped->info().times;
+  scans = read_all(*unstamped);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_LE(largest_cell_error_s(scans[0], known), column_s(spec.sensor));
+
+  // Points out of order: no times, counted per frame.
+  std::vector<Eigen::Vector3f> shuffled = cloud.xyz;
+  std::shuffle(shuffled.begin() + 16, shuffled.end(), std::mt19937(9));
+  write_bin(velodyne / "000001.bin", shuffled);
+  const auto mixed = open_scan_folder(velodyne.string(), {});
+  scans = read_all(*mixed);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(mixed->stats().warning_count, 1u);
+  ASSERT_EQ(mixed->stats().warnings.size(), 1u);
+  EXPECT_NE(mixed->stats().warnings[0].find("000001.bin: no per-point times from the azimuth"),
+            std::string::npos)
+      << mixed->stats().warnings[0];
+  EXPECT_EQ(std::count(scans[1].time_offset_s.begin(), scans[1].time_offset_s.end(), 0.0f),
+            static_cast<std::ptrdiff_t>(scans[1].size()));
 }
 
 }  // namespace
