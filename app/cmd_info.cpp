@@ -77,6 +77,7 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
                  {"rows", same_shape ? rows : -1},
                  {"cols", same_shape ? cols : -1},
                  {"fields", info.fields},
+                 {"times", info.times},
                  {"valid_points", valid},
                  {"time_span_s", span_s},
                  {"first_stamp_ns", first_stamp.value_or(0)},
@@ -103,6 +104,7 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
   }
   t += line;
   t += "fields:    " + join(info.fields) + "\n";
+  t += "times:     " + (info.times.empty() ? std::string("unknown") : info.times) + "\n";
   std::snprintf(line, sizeof line, "valid points per frame: min %.0f, median %.0f, max %.0f\n",
                 valid["min"].get<double>(), valid["median"].get<double>(),
                 valid["max"].get<double>());

@@ -168,7 +168,8 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   pipeline.total_frames = info.frames;
   pipeline.quiet = context.quiet;
   pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
-  spdlog::info("mapping {} ({}) with {}", info.path, info.format, locator->description());
+  spdlog::info("mapping {} ({}; per-point times {}) with {}", info.path, info.format,
+               info.times.empty() ? std::string("unknown") : info.times, locator->description());
 
   PipelineResult result;
   MapRunSummary summary;

@@ -19,6 +19,7 @@ nlohmann::json map_report_json(const MapRunSummary& summary) {
                      {"sensor", summary.input->sensor.name},
                      {"rows", summary.input->sensor.beams},
                      {"cols", summary.input->sensor.columns}};
+  report["input"]["times"] = summary.input->times;
   report["frames"] = run.frames_mapped;
   report["frames_read"] = run.frames_read;
   report["frames_skipped"] = {{"without_pose", run.frames_without_pose},

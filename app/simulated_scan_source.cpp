@@ -13,6 +13,7 @@ SimulatedScanSource::SimulatedScanSource(const PreparedSimulation& simulation,
   info_.sensor_from_metadata = true;
   info_.frames = simulation.frames;
   info_.fields = {"x", "y", "z", "intensity", "reflectivity", "t"};
+  info_.times = "per column, simulated";
 }
 
 std::optional<slam::Scan> SimulatedScanSource::next() {

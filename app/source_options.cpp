@@ -38,6 +38,7 @@ std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& confi
   options.sensor_preset = config.sensor.preset;
   options.min_range_m = config.sensor.min_range_m;
   options.max_range_m = config.sensor.max_range_m;
+  options.times_from_azimuth = config.sensor.times_from_azimuth;
   return slam::open_scan_source(input, options);
 }
 

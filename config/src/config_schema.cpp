@@ -170,6 +170,7 @@ std::vector<KeySpec> make_specs() {
       optional_number_key("sensor.max_range", &Config::sensor, &SensorConfig::max_range_m,
                           {0.0, 10000.0, true}),
       bool_key("sensor.drop_mixed_pixels", &Config::sensor, &SensorConfig::drop_mixed_pixels),
+      bool_key("sensor.times_from_azimuth", &Config::sensor, &SensorConfig::times_from_azimuth),
       number_key("map.voxel_size", &Config::map, &MapConfig::voxel_size_m, {0.005, 2.0}),
       number_key("map.truncation", &Config::map, &MapConfig::truncation_m, {0.0, 10.0, true}),
       number_key("map.max_weight", &Config::map, &MapConfig::max_weight, {1.0, 500.0}),

@@ -40,6 +40,25 @@ TEST(Cli, InfoOnTheBuiltInExampleReportsItsShape) {
   EXPECT_EQ(info["valid_points"]["min"], 128 * 1024);
   EXPECT_EQ(info["valid_points"]["median"], 128 * 1024);
   EXPECT_NEAR(info["time_span_s"].get<double>(), 0.9, 1e-6);
+  EXPECT_EQ(info["times"], "per column, simulated");
+}
+
+TEST(Cli, InfoSaysWhereThePointTimesComeFrom) {
+  // An HDL-32 scan without a time field, its points in firing order from 270 deg on.
+  FEATSENSE_SHARED_FILE(pcd, "velodyne/251370668.pcd");
+  const CommandResult derived = run_featsense("info --quiet " + pcd.string());
+  ASSERT_EQ(derived.exit_code, 0) << derived.output;
+  EXPECT_NE(derived.output.find("times:     from the azimuth (the sweep began 270.1 deg "
+                                "clockwise of +x, points in firing order; 0 s where it began)"),
+            std::string::npos)
+      << derived.output;
+  const CommandResult off =
+      run_featsense("info --quiet " + pcd.string() + " --set sensor.times_from_azimuth=false");
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_NE(off.output.find("times:     none: no time field, and sensor.times_from_azimuth is "
+                            "false"),
+            std::string::npos)
+      << off.output;
 }
 
 TEST(Cli, RangeLimitsFromTheConfigDropPoints) {

@@ -199,6 +199,66 @@ TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {
   EXPECT_EQ(open_bag(no_ring_path, options)->info().sensor.name, "hdl32");
 }
 
+TEST(Rosbag, CloudsWithoutTimesGetThemFromTheAzimuth) {
+  // The reference scene turns clockwise from +x over its 64 columns, row after row: every
+  // point's time is its column's share of the revolution after the header stamp.
+  const auto dir = test::scratch_dir("rosbag_azimuth_times");
+  CloudSpec spec;
+  spec.time_field = "";
+  test::TestCloud organized = test::make_reference_cloud(spec);
+  test::TestCloud flat = organized;
+  flat.width *= flat.height;
+  flat.height = 1;
+  flat.row_step = flat.width * flat.point_step;
+  TestBagWriter writer(TestCompression::kNone);
+  const uint32_t image = writer.add_connection("/image", "sensor_msgs/PointCloud2");
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  writer.add_message(image, kFirstStamp, organized.serialize());
+  writer.add_message(points, kFirstStamp, flat.serialize());
+  const std::string path = test::write_bag_file(dir, "t.bag", writer.finish());
+  const double column_s = 1.0 / (test::kRefCols * 10.0);  // vlp16: 10 Hz
+
+  SourceOptions options;
+  options.topic = "/image";
+  std::unique_ptr<ScanSource> source = open_bag(path, options);
+  EXPECT_TRUE(contains(source->info().times, "from the azimuth (the sweep began 0.0 deg"))
+      << source->info().times;
+  std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  EXPECT_EQ(source->stats().warning_count, 0u);
+  for (int row = 0; row < test::kRefRows; ++row) {
+    for (int col = 0; col < test::kRefCols; ++col) {
+      const size_t i = scans[0].index(row, col);
+      if (scans[0].valid[i]) {
+        EXPECT_NEAR(scans[0].time_offset_s[i], col * column_s, 1e-6);
+      }
+    }
+  }
+
+  options.topic = "/points";
+  test::StandInLog log;
+  source = open_rosbag_source(path, options, test::stand_in_dependencies(log));
+  scans = test::read_scans(*source);
+  ASSERT_EQ(log.organized_clouds.size(), 1u);
+  const PointCloud& handed = log.organized_clouds[0];
+  ASSERT_EQ(handed.time_offset_s.size(), handed.size());
+  for (size_t i = 0; i < handed.size(); ++i) {
+    if (!handed.xyz[i].isZero() && handed.xyz[i].allFinite()) {
+      EXPECT_NEAR(handed.time_offset_s[i], static_cast<double>(i % test::kRefCols) * column_s,
+                  1e-6);
+    }
+  }
+
+  // sensor.times_from_azimuth: false.
+  options.topic = "/image";
+  options.times_from_azimuth = false;
+  source = open_bag(path, options);
+  EXPECT_EQ(source->info().times, "none: no time field, and sensor.times_from_azimuth is false");
+  scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  for (const float t : scans[0].time_offset_s) EXPECT_EQ(t, 0.0f);
+}
+
 // ---------------------------------------------------------------------------------------
 // Topic choice
 

@@ -16,12 +16,13 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A KITTI .bin of `points` points on the HDL-64's beam `beam`, all at distance `tag` + 5 m
-/// so that the frame tells which file it came from.
+/// so that the frame tells which file it came from; clockwise from +x seen from above, as
+/// the sensor measures them.
 void write_bin(const fs::path& path, int tag, int points = 50) {
   const config::SensorModel hdl64 = config::sensor_preset("hdl64");
   std::ofstream out(path, std::ios::binary);
   for (int i = 0; i < points; ++i) {
-    const double e = hdl64.elevation_rad[10], a = 2 * M_PI * i / points, d = 5.0 + tag;
+    const double e = hdl64.elevation_rad[10], a = -2 * M_PI * i / points, d = 5.0 + tag;
     const float p[4] = {static_cast<float>(d * std::cos(e) * std::cos(a)),
                         static_cast<float>(d * std::cos(e) * std::sin(a)),
                         static_cast<float>(d * std::sin(e)), 0.5f};

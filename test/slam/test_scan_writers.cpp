@@ -122,14 +122,32 @@ TEST(ScanWriters, KittiBinHoldsValidPointsWithNormalisedIntensity) {
     if (scan.valid[i]) largest = std::max(largest, reflectivity.values[i]);
   }
   ASSERT_EQ(largest, 99.0f);
+  // In firing order: column by column from the first measured (0 here), each from the
+  // highest beam down.
   size_t k = 0;
-  for (size_t i = 0; i < scan.size(); ++i) {
-    if (!scan.valid[i]) continue;
-    float point[4];
-    std::memcpy(point, bytes.data() + 16 * k++, 16);
-    EXPECT_EQ(Eigen::Vector3f(point[0], point[1], point[2]), scan.xyz[i]);
-    EXPECT_FLOAT_EQ(point[3], reflectivity.values[i] / largest);
+  for (int c = 0; c < scan.cols; ++c) {
+    for (int r = 0; r < scan.rows; ++r) {
+      const size_t i = scan.index(r, c);
+      if (!scan.valid[i]) continue;
+      float point[4];
+      std::memcpy(point, bytes.data() + 16 * k++, 16);
+      EXPECT_EQ(Eigen::Vector3f(point[0], point[1], point[2]), scan.xyz[i]);
+      EXPECT_FLOAT_EQ(point[3], reflectivity.values[i] / largest);
+    }
   }
+  // A sweep that began mid-scan (KITTI's, behind the sensor) starts the file there.
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      scan.time_offset_s[scan.index(r, c)] = static_cast<float>((c + 900) % scan.cols) * 5.5e-5f;
+    }
+  }
+  write_scan_kitti_bin(scan, file.string());
+  const std::string from_behind = read_file(file);
+  const size_t first = scan.index(0, 900);  // (0 + 900) % 3 == 0: a return
+  ASSERT_TRUE(scan.valid[first]);
+  float point[4];
+  std::memcpy(point, from_behind.data(), 16);
+  EXPECT_EQ(Eigen::Vector3f(point[0], point[1], point[2]), scan.xyz[first]);
   // No intensity channel at all: zeros.
   scan.channels.clear();
   write_scan_kitti_bin(scan, file.string());

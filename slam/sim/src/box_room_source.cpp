@@ -28,6 +28,7 @@ class BoxRoomSource final : public ScanSource {
     info_.frames = static_cast<size_t>(settings_.frames);
     info_.fields = {"x", "y", "z", "range", "t"};
     info_.detail = "analytic scans of an empty box room, sensor moving in a straight line";
+    info_.times = "per column, simulated";
   }
 
   std::optional<Scan> next() override {

@@ -17,6 +17,10 @@ struct SensorConfig {
   std::optional<double> max_range_m;  ///< metres; unset: the sensor model's own limit
   /// Drop veil points between a foreground edge and the surface behind it.
   bool drop_mixed_pixels = true;
+  /// Clouds without a per-point time field (KITTI .bin, many PCD / PLY files and
+  /// PointCloud2 messages) get each point's time from its azimuth, where the points are
+  /// stored in the order the sensor measured them (slam/io azimuth_times.hpp).
+  bool times_from_azimuth = true;
 };
 
 enum class Backend { kAuto, kCuda, kCpu };

@@ -27,7 +27,10 @@ class CloudFileSource final : public ScanSource {
     info_.fields = decoded.fields;
     OrganizeStats stats;
     std::vector<std::string> warnings;
-    scan_ = cloud_to_scan(decoded, info_.sensor, path, &stats, &warnings);
+    // The stamp (below) is never KITTI's: derived times count from the sweep's start.
+    CloudTiming timing;
+    timing.from_azimuth = options.times_from_azimuth;
+    scan_ = cloud_to_scan(decoded, info_.sensor, path, &stats, &warnings, timing, &info_.times);
     info_.detail = cloud::describe(stats, &warnings, path) + "; sensor " + why;
     for (const std::string& w : warnings) warn(w);
     // As in folders: a stamp in the name, else the one the file states, else 0.

@@ -6,7 +6,9 @@
 #include <limits>
 
 #include "cloud/sensor_guess.hpp"
+#include "featsense/slam/io/azimuth_times.hpp"
 #include "featsense/slam/io/cloud_files.hpp"
+#include "featsense/slam/io/point_fields.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "point_validity.hpp"
 
@@ -26,8 +28,10 @@ std::string preset_list() {
 constexpr double kMinTimeSpanRevolutions = 0.25;
 constexpr double kMaxTimeSpanRevolutions = 2.0;
 
-/// Drops per-point times that cannot be offsets within this revolution; say why.
-void check_times(Scan& scan, double rate_hz, const std::string& origin,
+/// Drops per-point times that cannot be offsets within this revolution, says why, and
+/// returns whether it dropped them. Offsets may be negative (a stamp mid-sweep): only their
+/// span counts.
+bool check_times(Scan& scan, double rate_hz, const std::string& origin,
                  std::vector<std::string>* warnings) {
   float earliest = std::numeric_limits<float>::infinity();
   float latest = -earliest;
@@ -41,7 +45,7 @@ void check_times(Scan& scan, double rate_hz, const std::string& origin,
       column_used[static_cast<size_t>(c)] = 1;
     }
   }
-  if (!(latest >= earliest) || scan.cols == 0) return;
+  if (!(latest >= earliest) || scan.cols == 0) return false;
   const double span_s = static_cast<double>(latest) - static_cast<double>(earliest);
   const double revolution_s = 1.0 / rate_hz;
   const double columns_used =
@@ -49,8 +53,8 @@ void check_times(Scan& scan, double rate_hz, const std::string& origin,
       static_cast<double>(scan.cols);
   const bool too_short = columns_used >= 0.5 && span_s < kMinTimeSpanRevolutions * revolution_s;
   const bool too_long = span_s > kMaxTimeSpanRevolutions * revolution_s;
-  if (!too_short && !too_long) return;
-  if (span_s == 0.0) return;  // no times at all: nothing to drop
+  if (!too_short && !too_long) return false;
+  if (span_s == 0.0) return false;  // no times at all: nothing to drop
   std::fill(scan.time_offset_s.begin(), scan.time_offset_s.end(), 0.0f);
   if (warnings) {
     warnings->push_back(origin + ": per-point times span " + std::to_string(span_s * 1e3) +
@@ -60,15 +64,25 @@ void check_times(Scan& scan, double rate_hz, const std::string& origin,
                         std::to_string(revolution_s * 1e3) + " ms: not times within the scan" +
                         (too_short ? " (per packet?)" : " (other units?)") + "; set to 0");
   }
+  return true;
 }
 
-Scan organized_to_scan(const DecodedCloud& decoded, const std::string& origin,
-                       OrganizeStats* stats) {
+/// The file's field that gave the per-point times: the first of time meaning, as the
+/// decoders take it.
+std::string time_field_name(const DecodedCloud& decoded) {
+  for (const std::string& name : decoded.fields) {
+    if (classify_field(name).role == FieldRole::kTime) return name;
+  }
+  return "time";
+}
+
+/// `times`: per cell, from the file or the azimuth; empty for none.
+Scan organized_to_scan(const DecodedCloud& decoded, const std::vector<float>& times,
+                       const std::string& origin, OrganizeStats* stats) {
   const PointCloud& cloud = decoded.cloud;
   const size_t cells = static_cast<size_t>(decoded.height) * static_cast<size_t>(decoded.width);
   auto fits = [cells](size_t n) { return n == 0 || n == cells; };
-  bool consistent =
-      cloud.size() == cells && fits(cloud.time_offset_s.size()) && fits(cloud.range_m.size());
+  bool consistent = cloud.size() == cells && fits(times.size()) && fits(cloud.range_m.size());
   for (const ScanChannel& c : cloud.channels) consistent = consistent && c.values.size() == cells;
   if (!consistent) {
     throw InputError(origin + ": an organized cloud of " + std::to_string(decoded.height) + " x " +
@@ -77,13 +91,13 @@ Scan organized_to_scan(const DecodedCloud& decoded, const std::string& origin,
   }
   Scan scan = Scan::allocate(decoded.height, decoded.width);
   for (const ScanChannel& c : cloud.channels) scan.add_channel(c.name).values = c.values;
-  const bool has_time = !cloud.time_offset_s.empty();
+  const bool has_time = !times.empty();
   const bool has_range = !cloud.range_m.empty();
   OrganizeStats counts;
   counts.input_points = cloud.size();
   for (size_t i = 0; i < scan.size(); ++i) {
     // Times and channels of empty cells as the file has them: the cell stays a cell.
-    if (has_time) scan.time_offset_s[i] = cloud.time_offset_s[i];
+    if (has_time) scan.time_offset_s[i] = times[i];
     if (!is_return(cloud.xyz[i])) {
       ++counts.dropped_invalid;
       continue;
@@ -208,19 +222,43 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
 
 Scan cloud_to_scan(const DecodedCloud& decoded, const config::SensorModel& sensor,
                    const std::string& origin, OrganizeStats* stats,
-                   std::vector<std::string>* warnings) {
+                   std::vector<std::string>* warnings, const CloudTiming& timing,
+                   std::string* times) {
+  auto say = [times](std::string text) {
+    if (times) *times = std::move(text);
+  };
+  const bool has_time_field = !decoded.cloud.time_offset_s.empty();
+  const std::string field = has_time_field ? time_field_name(decoded) : std::string();
+  AzimuthTimes derived;
+  const bool derive = !has_time_field && timing.from_azimuth;
+  if (derive) {
+    derived = azimuth_times(decoded.cloud.xyz, sensor.rate_hz, timing.reference);
+    if (!derived.found() && warnings) {
+      warnings->push_back(origin + ": no per-point times from the azimuth: " + derived.problem);
+    }
+  }
+  say(describe_times(field, derive ? &derived : nullptr));
+  const std::vector<float>& point_times =
+      derived.found() ? derived.offset_s : decoded.cloud.time_offset_s;
+
   Scan scan;
   if (decoded.organized()) {
     if (sensor.beams != decoded.height) {
       throw InputError(origin + ": an organized cloud of " + std::to_string(decoded.height) +
                        " rows for a sensor of " + std::to_string(sensor.beams) + " beams");
     }
-    scan = organized_to_scan(decoded, origin, stats);
+    scan = organized_to_scan(decoded, point_times, origin, stats);
+  } else if (derived.found()) {
+    PointCloud timed = decoded.cloud;  // organize() takes the times from the cloud
+    timed.time_offset_s = std::move(derived.offset_s);
+    scan = organize(timed, sensor, stats);
   } else {
     scan = organize(decoded.cloud, sensor, stats);
   }
   scan.stamp_ns = decoded.stamp_ns.value_or(decoded.cloud.stamp_ns);
-  if (!decoded.cloud.time_offset_s.empty()) check_times(scan, sensor.rate_hz, origin, warnings);
+  if (has_time_field && check_times(scan, sensor.rate_hz, origin, warnings)) {
+    say("none: the field '" + field + "' holds no times within a revolution");
+  }
   return scan;
 }
 

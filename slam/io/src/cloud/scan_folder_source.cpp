@@ -64,6 +64,7 @@ class ScanFolderSource final : public ScanSource {
     std::error_code ec;
     if (!fs::is_directory(folder_, ec)) throw InputError(path + ": not a folder");
     info_.path = path;
+    timing_.from_azimuth = options.times_from_azimuth;
     if (fs::exists(folder_ / "sequence.yaml", ec)) {
       open_sequence(options);
     } else {
@@ -113,7 +114,7 @@ class ScanFolderSource final : public ScanSource {
       for (const std::string& w : decoded.warnings) warn(origin + ": " + w);
       OrganizeStats stats;
       std::vector<std::string> warnings;
-      Scan scan = cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings);
+      Scan scan = cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings, timing_);
       cloud::describe(stats, &warnings, origin);
       for (const std::string& w : warnings) warn(w);
       *file_stamp = decoded.stamp_ns;
@@ -176,18 +177,19 @@ class ScanFolderSource final : public ScanSource {
     const auto& [extension, files] = *by_extension.begin();
     format_ = *format_of_extension(extension);
     order_frames(files);
+    // Before the first frame is read: its times count from the instant its stamp stands for.
+    if (!frames_.front().stamp_ns && stamps_from_times_txt()) {
+      timing_.reference = SweepReference::kFacingForward;
+    }
 
     if (format_ == CloudFormat::kKittiBin) {
-      info_.format = "kitti-bin";
-      info_.sensor = sensor_for(options, "hdl64");
-      info_.fields = {"x", "y", "z", "reflectance"};
+      open_first_cloud(options, sensor_for(options, "hdl64"));
       info_.detail =
           std::to_string(frames_.size()) + " KITTI .bin scans, sensor " + info_.sensor.name;
     } else {
       open_first_cloud(options, std::nullopt);
     }
     rate_hz_ = info_.sensor.rate_hz;
-    if (!frames_.front().stamp_ns) stamps_from_times_txt();
   }
 
   /// Name stamps order the frames when every name has one; else natural name order.
@@ -205,17 +207,18 @@ class ScanFolderSource final : public ScanSource {
     });
   }
 
-  void stamps_from_times_txt() {
+  /// KITTI's times.txt as the frames' stamps; whether it was used.
+  bool stamps_from_times_txt() {
     std::string used;
     const std::optional<std::vector<double>> seconds = read_times_txt(folder_, &used);
     if (!seconds) {
       if (!used.empty()) warn(used + ": not one time per line; not used");
-      return;
+      return false;
     }
     auto stamp = [](double s) { return static_cast<int64_t>(std::llround(s * 1e9)); };
     if (seconds->size() == frames_.size()) {
       for (size_t i = 0; i < frames_.size(); ++i) frames_[i].stamp_ns = stamp((*seconds)[i]);
-      return;
+      return true;
     }
     // A subset of a KITTI sequence: names are the frame numbers that index times.txt.
     std::vector<size_t> numbers;
@@ -224,17 +227,18 @@ class ScanFolderSource final : public ScanSource {
       if (!n || *n >= seconds->size()) {
         warn(used + " has " + std::to_string(seconds->size()) + " lines for " +
              std::to_string(frames_.size()) + " scans; not used");
-        return;
+        return false;
       }
       numbers.push_back(static_cast<size_t>(*n));
     }
     for (size_t i = 0; i < frames_.size(); ++i) frames_[i].stamp_ns = stamp((*seconds)[numbers[i]]);
+    return true;
   }
 
-  /// PCD and PLY folders: the first readable frame tells the fields and, unless `known`,
-  /// decides the sensor; it is kept for next(). A frame that cannot be read is skipped, and
-  /// a folder without any readable frame is an error. A sensor that cannot be chosen fails
-  /// at once, as it would for every frame.
+  /// The first readable frame tells the fields and where the times come from and, unless
+  /// `known`, decides the sensor; it is kept for next(). A frame that cannot be read is skipped,
+  /// and a folder without any readable frame is an error. A sensor that cannot be chosen fails at
+  /// once, as it would for every frame.
   void open_first_cloud(const SourceOptions& options,
                         const std::optional<config::SensorModel>& known) {
     std::string last_error;
@@ -253,7 +257,8 @@ class ScanFolderSource final : public ScanSource {
       OrganizeStats stats;
       std::vector<std::string> warnings;
       try {
-        first_ = cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings);
+        first_ =
+            cloud_to_scan(decoded, info_.sensor, origin, &stats, &warnings, timing_, &info_.times);
       } catch (const InputError& e) {
         last_error = e.what();
         skip_frame("frame skipped: " + last_error);
@@ -277,6 +282,7 @@ class ScanFolderSource final : public ScanSource {
   SourceInfo info_;
   std::vector<Frame> frames_;
   CloudFormat format_ = CloudFormat::kPcd;
+  CloudTiming timing_;
   double rate_hz_ = 10.0;
   size_t next_ = 0;
   std::optional<Scan> first_;

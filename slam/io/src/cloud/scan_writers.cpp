@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "cloud/scalar_type.hpp"
@@ -73,6 +74,22 @@ void check_scan(const Scan& scan, const std::string& path) {
                     scan.valid.size() == n && scan.rows <= 65535;
   for (const ScanChannel& c : scan.channels) consistent = consistent && c.values.size() == n;
   if (!consistent) throw WriteError(path + ": the scan's arrays do not match rows x cols");
+}
+
+/// Where the sweep began: the column measured first (the first of equals), 0 for a scan
+/// without times.
+int earliest_column(const Scan& scan) {
+  const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
+  int first = 0;
+  std::optional<float> earliest;
+  for (int col = 0; col < scan.cols; ++col) {
+    const std::optional<float>& t = times[static_cast<size_t>(col)];
+    if (t && (!earliest || *t < *earliest)) {
+      earliest = t;
+      first = col;
+    }
+  }
+  return first;
 }
 
 }  // namespace
@@ -147,14 +164,21 @@ void write_scan_kitti_bin(const Scan& scan, const std::string& path) {
   std::vector<uint8_t> body;
   body.reserve(scan.valid_count() * 16);
   uint8_t point[16];
-  for (size_t i = 0; i < scan.size(); ++i) {
-    if (!scan.valid[i]) continue;
-    const float value = intensity && largest > 0.0f ? intensity->values[i] / largest : 0.0f;
-    store_f32_le(point + 0, scan.xyz[i].x());
-    store_f32_le(point + 4, scan.xyz[i].y());
-    store_f32_le(point + 8, scan.xyz[i].z());
-    store_f32_le(point + 12, std::isfinite(value) ? std::clamp(value, 0.0f, 1.0f) : 0.0f);
-    body.insert(body.end(), point, point + 16);
+  // The points in the order they were measured, which is all that tells their times to a
+  // reader of a format without them (azimuth_times.hpp).
+  const int first_col = earliest_column(scan);
+  for (int k = 0; k < scan.cols; ++k) {
+    const int col = (first_col + k) % scan.cols;
+    for (int row = 0; row < scan.rows; ++row) {
+      const size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      const float value = intensity && largest > 0.0f ? intensity->values[i] / largest : 0.0f;
+      store_f32_le(point + 0, scan.xyz[i].x());
+      store_f32_le(point + 4, scan.xyz[i].y());
+      store_f32_le(point + 8, scan.xyz[i].z());
+      store_f32_le(point + 12, std::isfinite(value) ? std::clamp(value, 0.0f, 1.0f) : 0.0f);
+      body.insert(body.end(), point, point + 16);
+    }
   }
   write_file(path, "", body);
 }

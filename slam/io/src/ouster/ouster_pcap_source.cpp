@@ -96,6 +96,7 @@ class OusterPcapSource final : public ScanSource {
     info_.fields = {"x", "y", "z", "range", "t", "reflectivity", "nir"};
     if (meta.profile != OusterProfile::kRng15Rfl8Nir8) info_.fields.push_back("signal");
     info_.detail = meta.prod_line + " " + meta.lidar_mode + " " + to_string(meta.profile);
+    info_.times = "per column, from the lidar packets' timestamps";
   }
 
   std::optional<Scan> next() override {

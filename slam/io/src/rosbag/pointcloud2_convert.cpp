@@ -226,6 +226,10 @@ PointCloud cloud_to_points(const PointCloud2View& cloud, int64_t fallback_stamp_
   return points;
 }
 
+const PointFieldDesc* time_field(const PointCloud2View& cloud) {
+  return first_field(cloud, kTimeFields);
+}
+
 int ring_count(const PointCloud2View& cloud) {
   const PointFieldDesc* field = first_field(cloud, kRingFields);
   if (field == nullptr) return 0;

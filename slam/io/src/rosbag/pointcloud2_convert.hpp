@@ -38,6 +38,10 @@ Scan organized_cloud_to_scan(const PointCloud2View& cloud, int64_t fallback_stam
 /// has the higher mean elevation.
 PointCloud cloud_to_points(const PointCloud2View& cloud, int64_t fallback_stamp_ns);
 
+/// The field the per-point times are read from (the first of the names above), or nullptr
+/// where the cloud has none.
+const PointFieldDesc* time_field(const PointCloud2View& cloud);
+
 /// Largest ring index + 1 in the cloud, or 0 where it has no ring field.
 int ring_count(const PointCloud2View& cloud);
 

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "featsense/slam/io/azimuth_times.hpp"
 #include "rosbag/cloud_sensor_model.hpp"
 #include "rosbag/pointcloud2.hpp"
 #include "rosbag/pointcloud2_convert.hpp"
@@ -14,13 +15,22 @@ std::string describe_message(uint64_t index, const BagMessage& message) {
          std::to_string(message.offset) + ")";
 }
 
+/// Per-point times from the azimuth (azimuth_times.hpp) of a cloud's points in the order
+/// the message stores them; a message's stamp is its sweep's start.
+AzimuthTimes times_from_azimuth(const std::vector<Eigen::Vector3f>& xyz,
+                                const config::SensorModel& sensor) {
+  return azimuth_times(xyz, sensor.rate_hz, SweepReference::kSweepStart);
+}
+
 /// What the first readable cloud of a topic tells about all of them.
 struct FirstCloud {
   uint32_t height = 0;
   uint32_t width = 0;
   std::vector<std::string> fields;
+  std::string time_field;  ///< empty where the clouds have none
   int rings = 0;
-  std::optional<Scan> organized;  ///< row 0 the highest beam
+  std::optional<Scan> organized;     ///< row 0 the highest beam
+  std::vector<Eigen::Vector3f> xyz;  ///< the points in the order the message stores them
 };
 
 FirstCloud read_first_cloud(const BagTopicContext& context) {
@@ -47,10 +57,14 @@ FirstCloud read_first_cloud(const BagTopicContext& context) {
         first.height = cloud.height;
         first.width = cloud.width;
         for (const PointFieldDesc& field : cloud.fields) first.fields.push_back(field.name);
+        if (const PointFieldDesc* time = time_field(cloud)) first.time_field = time->name;
         first.rings = ring_count(cloud);
         if (cloud.height > 1) {
           first.organized = organized_cloud_to_scan(cloud, message->time_ns);
+          first.xyz = first.organized->xyz;
           if (rows_lowest_first(*first.organized).value_or(false)) flip_rows(*first.organized);
+        } else {
+          first.xyz = cloud_to_points(cloud, message->time_ns).xyz;
         }
         return first;
       }
@@ -103,8 +117,11 @@ config::SensorModel choose_sensor(const BagTopicContext& context, const FirstClo
 
 }  // namespace
 
-PointCloud2Decoder::PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize)
-    : sensor_(std::move(sensor)), organize_(std::move(organize)) {}
+PointCloud2Decoder::PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize,
+                                       bool times_from_azimuth)
+    : sensor_(std::move(sensor)),
+      organize_(std::move(organize)),
+      times_from_azimuth_(times_from_azimuth) {}
 
 std::optional<Scan> PointCloud2Decoder::decode(const BagMessage& message,
                                                const DecodeReport& report) {
@@ -120,13 +137,30 @@ std::optional<Scan> PointCloud2Decoder::decode(const BagMessage& message,
     report.skip_frame(describe_message(index, message) + ": " + problem);
     return std::nullopt;
   }
+  const bool derive_times = times_from_azimuth_ && time_field(cloud) == nullptr;
+  // Where the points' order tells no times they stay 0, with a warning.
+  auto derived = [&](const std::vector<Eigen::Vector3f>& xyz) {
+    AzimuthTimes times = times_from_azimuth(xyz, sensor_);
+    if (!times.found()) {
+      report.warn(describe_message(index, message) +
+                  ": no per-point times from the azimuth: " + times.problem);
+    }
+    return std::move(times.offset_s);
+  };
   Scan scan;
   if (cloud.height > 1) {
     scan = organized_cloud_to_scan(cloud, message.time_ns);
+    if (derive_times) {
+      if (std::vector<float> times = derived(scan.xyz); !times.empty()) {
+        scan.time_offset_s = std::move(times);
+      }
+    }
     if (!lowest_first_) lowest_first_ = rows_lowest_first(scan);
     if (lowest_first_.value_or(false)) flip_rows(scan);
   } else {
-    scan = organize_(cloud_to_points(cloud, message.time_ns), sensor_);
+    PointCloud points = cloud_to_points(cloud, message.time_ns);
+    if (derive_times) points.time_offset_s = derived(points.xyz);
+    scan = organize_(points, sensor_);
   }
   scan.sequence = index;
   return scan;
@@ -146,7 +180,14 @@ std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& 
   info.frames = static_cast<size_t>(context.topic.messages);
   info.detail = (first.organized ? "organized " : "unorganized ") + std::to_string(first.height) +
                 " x " + std::to_string(first.width) + ", " + how;
-  return std::make_unique<PointCloud2Decoder>(std::move(sensor), std::move(organize));
+  const bool from_azimuth = context.options.times_from_azimuth;
+  if (first.time_field.empty() && from_azimuth) {
+    const AzimuthTimes derived = times_from_azimuth(first.xyz, sensor);
+    info.times = describe_times("", &derived);
+  } else {
+    info.times = describe_times(first.time_field, nullptr);
+  }
+  return std::make_unique<PointCloud2Decoder>(std::move(sensor), std::move(organize), from_azimuth);
 }
 
 }  // namespace featsense::slam

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "featsense/config/config.hpp"
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/slam/point_cloud.hpp"
 #include "featsense/slam/scan_source.hpp"
@@ -20,8 +21,11 @@ using CloudOrganizer =
 
 class PointCloud2Decoder final : public BagScanDecoder {
  public:
-  /// `sensor` is the model unorganized clouds are organized for.
-  PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize);
+  /// `sensor` is the model unorganized clouds are organized for. Clouds without a time
+  /// field get per-point times from the azimuth when `times_from_azimuth`
+  /// (sensor.times_from_azimuth), counted from the message's stamp, the sweep's start.
+  PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize,
+                     bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth);
 
   /// Scan rows: row 0 the highest beam. An organized cloud stored lowest beam first is
   /// flipped; which way the topic's clouds run is decided on the first cloud that tells it,
@@ -32,13 +36,14 @@ class PointCloud2Decoder final : public BagScanDecoder {
  private:
   config::SensorModel sensor_;
   CloudOrganizer organize_;
+  bool times_from_azimuth_;
   std::optional<bool> lowest_first_;
   uint64_t message_index_ = 0;
 };
 
 /// Reads the first readable cloud of the topic to choose the sensor model (sensor.preset
 /// where set; else a preset by the beam count; else, for organized clouds, one estimated
-/// from that cloud), fills info.sensor, info.fields, info.frames and info.detail, and
+/// from that cloud), fills info.sensor, info.fields, info.frames, info.detail and info.times, and
 /// returns the decoder. Throws InputError where no message of the topic is readable or no
 /// sensor model fits.
 std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& context,

@@ -111,6 +111,7 @@ std::unique_ptr<BagScanDecoder> make_ouster_packet_decoder(const BagTopicContext
   info.fields = fields_of(metadata.profile);
   info.detail = metadata.prod_line + " " + metadata.lidar_mode + ", profile " +
                 to_string(metadata.profile) + ", metadata from " + json_origin;
+  info.times = "per column, from the lidar packets' timestamps";
   return std::make_unique<OusterPacketDecoder>(std::move(metadata));
 }
 

@@ -22,22 +22,32 @@ struct ScanChannel {
 ///
 /// Layout: index = row * cols + col. Row 0 is the highest beam (largest elevation), rows go
 /// down. Columns follow the sensor's firing order (clockwise seen from above, as Ouster and
-/// Velodyne sensors spin), so time grows with the column. Unorganized input is organized
-/// into this layout by ring or elevation (organize.hpp).
+/// Velodyne sensors spin), so time grows with the column from the one where the sweep began,
+/// round past the last column to the first. Unorganized input is organized into this layout
+/// by ring or elevation (organize.hpp).
+///
+/// Times: stamp_ns is the scan's reference instant and time_offset_s counts from it. Readers
+/// make it the instant the sweep began (offsets >= 0), except where a file's own time field
+/// counts from another instant (kept as it is), and in KITTI sequences stamped by times.txt:
+/// there it is the instant the laser faced +x, mid-sweep, and offsets run from about minus to
+/// plus half a revolution (slam/io azimuth_times.hpp, SweepReference). Consumers take
+/// negative offsets as times before the stamp.
 ///
 /// Invalid cells (no return, NaN, out of the range limits) have valid = 0, xyz = 0 and
 /// range_m = 0; they are not data.
 struct Scan {
   int rows = 0;
   int cols = 0;
-  int64_t stamp_ns = 0;   ///< time of the scan's reference instant (its first column), ns
-  uint64_t sequence = 0;  ///< 0-based index of the scan in its recording
+  int64_t stamp_ns = 0;              ///< the scan's reference instant (see Times above), ns
+  uint64_t sequence = 0;             ///< 0-based index of the scan in its recording
   std::vector<Eigen::Vector3f> xyz;  ///< sensor frame, metres
   /// The range the sensor reported, metres (Ouster: along the beam from the lidar origin,
   /// beam origin offset included); |xyz| where the source has no range of its own.
   std::vector<float> range_m;
-  std::vector<float> time_offset_s;  ///< per-point time after stamp_ns, seconds (for deskewing)
-  std::vector<uint8_t> valid;        ///< 1 where the cell holds a return
+  /// Per point, seconds after stamp_ns (negative before it), for deskewing; all 0 where the
+  /// source tells no times.
+  std::vector<float> time_offset_s;
+  std::vector<uint8_t> valid;  ///< 1 where the cell holds a return
   std::vector<ScanChannel> channels;
 
   /// A scan of rows x cols with every cell invalid and no channels.
@@ -48,9 +58,9 @@ struct Scan {
     return static_cast<size_t>(row) * static_cast<size_t>(cols) + static_cast<size_t>(col);
   }
   size_t valid_count() const;
-  /// When each column was measured, seconds after stamp_ns: the time of its first valid
-  /// point (sources with per-point times are honoured per column); nullopt for a column
-  /// without a valid point or a scan without times.
+  /// When each column was measured, seconds after stamp_ns (negative before it): the time of
+  /// its first valid point (sources with per-point times are honoured per column); nullopt
+  /// for a column without a valid point or a scan without times.
   std::vector<std::optional<float>> column_time_offsets_s() const;
 
   /// The channel of that name, or nullptr.

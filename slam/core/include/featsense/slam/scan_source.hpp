@@ -29,6 +29,9 @@ struct SourceInfo {
   std::optional<size_t> frames;       ///< known without reading the data (folders), else unset
   std::vector<std::string> fields;    ///< per-point fields the recording carries
   std::string detail;                 ///< one line for humans, e.g. "profile RNG15_RFL8_NIR8"
+  /// Where the per-point times come from, one line for humans: "per-point field 't'",
+  /// "from the azimuth (...)", "none: why"; as the first frame had them.
+  std::string times;
 };
 
 /// Counts of what a source skipped; warnings are counted, the first few kept verbatim.

@@ -9,7 +9,9 @@
 #include <string_view>
 #include <vector>
 
+#include "featsense/config/config.hpp"
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/io/azimuth_times.hpp"
 #include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/io/organize.hpp"
 #include "featsense/slam/point_cloud.hpp"
@@ -57,13 +59,26 @@ DecodedCloud decode_kitti_bin(std::string_view bytes, const std::string& origin)
 config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptions& options,
                                   const std::string& origin, std::string* why = nullptr);
 
+/// How cloud_to_scan() times the points of a cloud without a per-point time field.
+struct CloudTiming {
+  /// Times from the azimuth (azimuth_times.hpp); else none. Config key
+  /// sensor.times_from_azimuth.
+  bool from_azimuth = config::SensorConfig{}.times_from_azimuth;
+  /// What the scan's stamp will stand for, the zero of the derived times.
+  SweepReference reference = SweepReference::kSweepStart;
+};
+
 /// The cloud as a Scan of `sensor`. Organized clouds map cell by cell (rows flipped when the
 /// file lists the lowest beam first); others go through organize(). Per-point times that
 /// cannot be times within the revolution (a span far shorter than a revolution over most of
-/// the azimuth, as per-packet times are) are set to 0 with a warning. Throws InputError when
-/// an organized cloud's height differs from sensor.beams.
+/// the azimuth, as per-packet times are) are set to 0 with a warning. A cloud without a time
+/// field gets times from its points' azimuths as `timing` says; where their order tells none,
+/// they stay 0 with a warning. `times` (optional) tells where the times came from, for
+/// reports: "per-point field 't'", "from the azimuth (...)" or "none: why". Throws
+/// InputError when an organized cloud's height differs from sensor.beams.
 Scan cloud_to_scan(const DecodedCloud& decoded, const config::SensorModel& sensor,
                    const std::string& origin, OrganizeStats* stats = nullptr,
-                   std::vector<std::string>* warnings = nullptr);
+                   std::vector<std::string>* warnings = nullptr, const CloudTiming& timing = {},
+                   std::string* times = nullptr);
 
 }  // namespace featsense::slam

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "featsense/config/config.hpp"
 #include "featsense/slam/scan_source.hpp"
 
 namespace featsense::slam {
@@ -15,6 +16,9 @@ struct SourceOptions {
   std::string sensor_preset = "auto";    ///< config key sensor.preset
   std::optional<double> min_range_m;     ///< config key sensor.min_range (else the sensor's)
   std::optional<double> max_range_m;     ///< config key sensor.max_range (else the sensor's)
+  /// Config key sensor.times_from_azimuth: clouds without a time field get per-point times
+  /// from their points' azimuths (azimuth_times.hpp).
+  bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth;
 };
 
 /// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the

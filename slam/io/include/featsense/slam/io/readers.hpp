@@ -23,7 +23,10 @@ std::unique_ptr<ScanSource> open_pcd_file(const std::string& path, const SourceO
 /// One PLY point cloud (one frame).
 std::unique_ptr<ScanSource> open_ply_file(const std::string& path, const SourceOptions& options);
 /// A folder of scans: KITTI .bin, PCD or PLY files in name order, or a folder written by
-/// `featsense simulate` (it holds a sequence.yaml). Mixed formats are an error.
+/// `featsense simulate` (it holds a sequence.yaml). Mixed formats are an error. Stamps come
+/// from the file names, else KITTI's times.txt beside the scans or one folder up (the
+/// instants the laser faced +x: times derived from the azimuth count from there), else the
+/// files' own, else the frame's index over the rate.
 std::unique_ptr<ScanSource> open_scan_folder(const std::string& path, const SourceOptions& options);
 
 /// The sensor model a reader should use for a recording without metadata: the preset named

@@ -22,7 +22,9 @@ void write_scan_pcd(const Scan& scan, const std::string& path);
 /// Binary little-endian PLY of the valid points with the same fields as the PCD.
 void write_scan_ply(const Scan& scan, const std::string& path);
 /// KITTI .bin: float32 x y z intensity of the valid points (intensity scaled to 0..1 by the
-/// largest value of the channel, as KITTI's reflectance is).
+/// largest value of the channel, as KITTI's reflectance is), in firing order: column by
+/// column from the one measured first, each from the highest beam down. The format has no
+/// times; a reader takes them from the azimuth in that order.
 void write_scan_kitti_bin(const Scan& scan, const std::string& path);
 
 }  // namespace featsense::slam
