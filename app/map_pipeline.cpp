@@ -83,8 +83,14 @@ void read_scans(slam::ScanSource& source, const FrameRange& range, BoundedQueue<
   }
 }
 
+/// A scan with its place, on its way to becoming rays.
+struct PlacedScan {
+  slam::Scan scan;
+  slam::ScanPlacement placement;
+};
+
 void locate_scans(slam::ScanLocator& locator, bool drop_mixed, BoundedQueue<slam::Scan>& in,
-                  BoundedQueue<LocatedScan>& out, PipelineState& state, PipelineResult& result) {
+                  BoundedQueue<PlacedScan>& out, PipelineState& state, PipelineResult& result) {
   while (std::optional<slam::Scan> scan = in.pop()) {
     const Clock::time_point start = Clock::now();
     if (drop_mixed) result.mixed_pixels_dropped += slam::drop_mixed_pixels(*scan);
@@ -98,10 +104,21 @@ void locate_scans(slam::ScanLocator& locator, bool drop_mixed, BoundedQueue<slam
     // A placement that comes with a reason is a pose the front end could not trust (e.g.
     // the odometry's prediction): counted and kept.
     if (!why.empty()) state.warn(why, result);
-    LocatedScan located;
-    located.rays = scan_to_rays(*scan, *placement);
-    located.placement = std::move(*placement);
     result.timings.locate_ms.push_back(ms_since(start));
+    if (!out.push(PlacedScan{std::move(*scan), std::move(*placement)})) break;
+  }
+}
+
+/// Rays in a stage of their own: with odometry the front end is the pipeline's slowest
+/// stage, and the deskewing of every point need not wait for it.
+void make_rays(BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out,
+               PipelineResult& result) {
+  while (std::optional<PlacedScan> placed = in.pop()) {
+    const Clock::time_point start = Clock::now();
+    LocatedScan located;
+    located.rays = scan_to_rays(placed->scan, placed->placement);
+    located.placement = std::move(placed->placement);
+    result.timings.rays_ms.push_back(ms_since(start));
     if (!out.push(std::move(located))) break;
   }
 }
@@ -173,6 +190,7 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
   PipelineResult result;
   PipelineState state;
   BoundedQueue<slam::Scan> scans(settings.queue_capacity);
+  BoundedQueue<PlacedScan> placed(settings.queue_capacity);
   BoundedQueue<LocatedScan> located(settings.queue_capacity);
   const Clock::time_point start = Clock::now();
 
@@ -184,14 +202,21 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
   });
   std::thread front_end([&] {
     guarded(state, [&] {
-      locate_scans(locator, settings.drop_mixed_pixels, scans, located, state, result);
+      locate_scans(locator, settings.drop_mixed_pixels, scans, placed, state, result);
     });
     if (state.stopping()) scans.abandon();
+    placed.close();
+  });
+  std::thread rays([&] {
+    guarded(state, [&] { make_rays(placed, located, result); });
+    if (state.stopping()) placed.abandon();
     located.close();
   });
   guarded(state, [&] { MappingStage(open_map, settings, result).run(located); });
   located.abandon();
+  placed.abandon();
   scans.abandon();
+  rays.join();
   front_end.join();
   reader.join();
 

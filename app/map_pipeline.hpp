@@ -48,6 +48,7 @@ struct PipelineSettings {
 struct StageTimings {
   std::vector<double> read_ms;
   std::vector<double> locate_ms;
+  std::vector<double> rays_ms;  ///< a placed scan turned into rays (deskewed, in the map frame)
   std::vector<double> shift_ms;
   std::vector<double> integrate_ms;
   std::vector<double> flush_ms;
