@@ -1,5 +1,6 @@
 #include "featsense/slam/odometry/local_feature_map.hpp"
 
+#include <tbb/parallel_invoke.h>
 #include <nanoflann.hpp>
 
 #include <array>
@@ -103,11 +104,14 @@ void LocalFeatureMap::add(const std::vector<Eigen::Vector3f>& edges,
                           const std::vector<Eigen::Vector3f>& surfaces,
                           const Eigen::Isometry3d& T_map_sensor) {
   const Eigen::Vector3f center = T_map_sensor.translation().cast<float>();
-  for (VoxelMap* map : {&impl_->edges, &impl_->surfaces}) {
-    map->add(map == &impl_->edges ? edges : surfaces, T_map_sensor);
-    map->crop(center, impl_->radius);
-    map->rebuild();
-  }
+  // The two maps are independent: updated side by side where there are cores for it.
+  const auto update = [&](VoxelMap& map, const std::vector<Eigen::Vector3f>& points) {
+    map.add(points, T_map_sensor);
+    map.crop(center, impl_->radius);
+    map.rebuild();
+  };
+  tbb::parallel_invoke([&] { update(impl_->edges, edges); },
+                       [&] { update(impl_->surfaces, surfaces); });
 }
 
 void LocalFeatureMap::nearest_edges(const Eigen::Vector3d& query, int k, double max_distance_m,

@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -237,7 +238,8 @@ Eigen::Isometry3d solve(const Correspondences& c, const Eigen::Isometry3d& pose,
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   options.max_num_iterations = settings.solver_iterations;
-  options.num_threads = 1;
+  // The residual blocks are evaluated in parallel (64 residuals each: worth a thread).
+  options.num_threads = tbb::this_task_arena::max_concurrency();
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
   options.function_tolerance = 1e-14;
