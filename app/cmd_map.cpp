@@ -91,11 +91,24 @@ std::optional<KnownTrajectory> known_trajectory(const MapOptions& options,
   return ground_truth_beside(info);
 }
 
-nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts) {
+/// Whether the intensity image confirmed the edges, in words: the fusion is off by the config,
+/// or where the scans had no intensity channel.
+std::string intensity_fusion_text(const slam::odometry::OdometryCounts& counts, bool enabled) {
+  if (!enabled) return "off (odometry.intensity_fusion = false)";
+  if (counts.intensity_confirmed_scans == 0) return "off: the scans have no intensity channel";
+  if (counts.intensity_confirmed_scans < counts.scans) {
+    return "on for " + std::to_string(counts.intensity_confirmed_scans) + " of " +
+           std::to_string(counts.scans) + " scans (the others had no intensity channel)";
+  }
+  return "on";
+}
+
+nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool fusion_enabled) {
   return {{"scans", counts.scans},
           {"degenerate_scans", counts.degenerate_scans},
           {"failed_scans", counts.failed_scans},
           {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
+          {"intensity_fusion", intensity_fusion_text(counts, fusion_enabled)},
           {"features_per_scan",
            counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0},
           {"timings",
@@ -217,7 +230,14 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     summary.device_memory_bytes = integrator->memory_bytes();
   }
   nlohmann::json report = map_report_json(summary);
-  if (odometry) report["odometry"] = odometry_json(odometry->counts());
+  if (odometry) {
+    const slam::odometry::OdometryCounts counts = odometry->counts();
+    report["odometry"] = odometry_json(counts, config.odometry.intensity_fusion);
+    if (config.odometry.intensity_fusion && counts.intensity_confirmed_scans < counts.scans) {
+      spdlog::warn("intensity fusion {}: edges were taken from the geometry alone",
+                   intensity_fusion_text(counts, true));
+    }
+  }
   if (truth && result.poses.size() >= 2) {
     try {
       const slam::TrajectoryEvaluationSettings eval_settings;

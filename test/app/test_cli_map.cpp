@@ -207,6 +207,7 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
   ASSERT_TRUE(report.contains("odometry")) << report.dump(2);
   EXPECT_EQ(report["odometry"]["scans"].get<size_t>(), 12u);
   EXPECT_GT(report["odometry"]["features_per_scan"].get<double>(), 100.0);
+  EXPECT_EQ(report["odometry"]["intensity_fusion"], "on");
   ASSERT_TRUE(report["eval"].contains("traj")) << report.dump(2);
   // A sensor moving through a furnished room at walking speed, range noise on: the path
   // within a few centimetres of the truth after 1.1 s.

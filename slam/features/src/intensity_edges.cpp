@@ -33,7 +33,10 @@ std::optional<std::vector<uint8_t>> intensity_image(const Scan& scan,
   if (values.empty()) return std::nullopt;
   const float low = percentile(values, settings.intensity_percentile);
   const float high = std::max(percentile(values, 100.0 - settings.intensity_percentile), low);
-  const float scale = high > low ? 255.0f / (high - low) : 0.0f;
+  // One value throughout (a driver that fills the field with zeros): the channel tells
+  // nothing, and taken as an image without edges it would drop every geometric edge.
+  if (!(high > low)) return std::nullopt;
+  const float scale = 255.0f / (high - low);
 
   std::vector<uint8_t> grey(scan.size(), 0);
   for (int row = 0; row < scan.rows; ++row) {
