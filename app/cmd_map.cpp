@@ -107,6 +107,7 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool 
   return {{"scans", counts.scans},
           {"degenerate_scans", counts.degenerate_scans},
           {"failed_scans", counts.failed_scans},
+          {"time_jumps", counts.time_jumps},
           {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
           {"intensity_fusion", intensity_fusion_text(counts, fusion_enabled)},
           {"features_per_scan",

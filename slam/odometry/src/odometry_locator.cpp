@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -54,11 +55,13 @@ class FeatureOdometryLocator final : public OdometryLocator {
     counts_.features_sum += static_cast<double>(found.size());
     if (found.intensity_confirmed) ++counts_.intensity_confirmed_scans;
     if (result.diagnostics.degenerate) ++counts_.degenerate_scans;
+    const std::string jump = time_jump(result.elapsed_s, counts_.scans > 1, scan.sequence);
     if (!result.diagnostics.converged && counts_.scans > 1) {
       ++counts_.failed_scans;
       why = "scan " + std::to_string(scan.sequence) + " not registered (" + result.reason +
             "): the pose is the prediction";
     }
+    if (!jump.empty()) why = why.empty() ? jump : why + "; " + jump;
     if (result.elapsed_s > 0.0) {
       last_motion_ = result.T_previous_sensor;
       last_period_s_ = result.elapsed_s;
@@ -93,12 +96,34 @@ class FeatureOdometryLocator final : public OdometryLocator {
   OdometryCounts counts() const override { return counts_; }
 
  private:
+  /// A warning when the time since the last scan is not one scan period: frames dropped (more
+  /// than 1.5 periods: the prediction was scaled to the gap) or a stamp that does not grow.
+  /// The period is the shortest gap seen so far.
+  std::string time_jump(double elapsed_s, bool after_first, uint64_t sequence) {
+    if (!after_first) return {};
+    if (!(elapsed_s > 0.0)) {
+      ++counts_.time_jumps;
+      return "scan " + std::to_string(sequence) +
+             ": its stamp is not after the last scan's: no motion predicted";
+    }
+    if (!(period_s_ > 0.0) || elapsed_s < period_s_) period_s_ = elapsed_s;
+    if (elapsed_s <= 1.5 * period_s_) return {};
+    ++counts_.time_jumps;
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "scan %llu: %.3f s since the last scan, %.1f scan periods (frames dropped?): "
+                  "the motion was predicted over the gap",
+                  static_cast<unsigned long long>(sequence), elapsed_s, elapsed_s / period_s_);
+    return text;
+  }
+
   features::FeatureSettings features_;
   FeatureOdometry odometry_;
   bool deskew_;
   Eigen::Isometry3d T_map_first_;
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
   double last_period_s_ = 0.0;
+  double period_s_ = 0.0;  ///< the shortest time between two scans so far
   OdometryCounts counts_;
 };
 

@@ -19,6 +19,7 @@ struct OdometryCounts {
   size_t scans = 0;
   size_t degenerate_scans = 0;  ///< a direction of motion held at the prediction
   size_t failed_scans = 0;      ///< the pose is the prediction (the reason is logged)
+  size_t time_jumps = 0;        ///< frames dropped, or a stamp that did not grow
   size_t intensity_confirmed_scans = 0;
   double features_sum = 0.0;            ///< edge + surface points, summed over scans
   std::vector<double> features_ms;      ///< per scan: the feature extraction
