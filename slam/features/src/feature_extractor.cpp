@@ -1,6 +1,7 @@
 #include "featsense/slam/features/feature_extractor.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <chrono>
 #include <optional>
@@ -63,23 +64,29 @@ FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
     return set;
   }
 
-  auto stage = Clock::now();
-  const std::vector<float> curvature = curvature_image(scan, settings.neighbours);
-  const std::vector<uint8_t> excluded = excluded_cells(scan, settings);
-  local.curvature_ms = ms_since(stage);
-
-  stage = Clock::now();
-  std::vector<LinePicks> lines(static_cast<size_t>(scan.rows));
-  tbb::parallel_for(0, scan.rows, [&](int row) {
-    const size_t at = scan.index(row, 0);
-    lines[static_cast<size_t>(row)] =
-        select_line_features(curvature.data() + at, excluded.data() + at, scan.cols, settings);
-  });
-  local.selection_ms = ms_since(stage);
-
-  stage = Clock::now();
+  // The intensity image does not depend on the geometry until the fusion: the two are made
+  // side by side (the curvature and the selection are parallel over rows themselves).
   std::optional<std::vector<uint8_t>> image_edges;
-  if (settings.intensity_fusion) image_edges = intensity_edges(scan, settings);
+  std::vector<LinePicks> lines(static_cast<size_t>(scan.rows));
+  tbb::parallel_invoke(
+      [&] {
+        const auto stage = Clock::now();
+        if (settings.intensity_fusion) image_edges = intensity_edges(scan, settings);
+        local.intensity_ms = ms_since(stage);
+      },
+      [&] {
+        auto stage = Clock::now();
+        const std::vector<float> curvature = curvature_image(scan, settings.neighbours);
+        const std::vector<uint8_t> excluded = excluded_cells(scan, settings);
+        local.curvature_ms = ms_since(stage);
+        stage = Clock::now();
+        tbb::parallel_for(0, scan.rows, [&](int row) {
+          const size_t at = scan.index(row, 0);
+          lines[static_cast<size_t>(row)] = select_line_features(
+              curvature.data() + at, excluded.data() + at, scan.cols, settings);
+        });
+        local.selection_ms = ms_since(stage);
+      });
   set.intensity_confirmed = image_edges.has_value();
   const bool has_times = scan.time_offset_s.size() == scan.size();
   auto time_of = [&](size_t i) { return has_times ? scan.time_offset_s[i] : 0.0f; };
@@ -101,7 +108,6 @@ FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
       set.surface_time_s.push_back(time_of(i));
     }
   }
-  local.intensity_ms = ms_since(stage);
 
   local.edges = set.edges.size();
   local.surfaces = set.surfaces.size();

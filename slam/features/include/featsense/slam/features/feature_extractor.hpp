@@ -41,7 +41,7 @@ struct FeatureStats {
   bool intensity_confirmed = false;
   double curvature_ms = 0.0;  ///< curvature and the filters
   double selection_ms = 0.0;
-  double intensity_ms = 0.0;  ///< the intensity image and the fusion
+  double intensity_ms = 0.0;  ///< the intensity image (made beside the curvature and selection)
   double total_ms = 0.0;
 };
 
