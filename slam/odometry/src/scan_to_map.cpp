@@ -26,6 +26,8 @@ constexpr size_t kMinCorrespondences = 10;
 /// An outer loop that moves the pose less than this ends the registration: far below the
 /// range noise, and small enough that the errors it leaves do not add up over a run.
 constexpr double kSettledMoveM = 1e-4;
+/// A scan point that has moved less than this since its last search keeps its line or plane.
+constexpr double kReuseDistanceM = 0.02;
 
 /// Residuals per Ceres cost function: Ceres' overhead per block (a virtual call, the loss, a
 /// Jacobian block written into the problem's matrix) costs more than a residual itself.
@@ -79,32 +81,58 @@ struct Correspondences {
   size_t size() const { return lines.size() + planes.size(); }
 };
 
+/// Each scan point's line or plane from its last search, and where the point lay then: a
+/// point that has moved less than kReuseDistanceM since (the outer loops after the first move
+/// the pose by millimetres) keeps it, as its five nearest map points, 0.2 - 0.4 m apart,
+/// would be the same.
+template <class Residual>
+struct MatchCache {
+  std::vector<Eigen::Vector3d> searched_at;
+  std::vector<std::optional<Residual>> fit;
+  std::vector<uint8_t> searched;
+};
+
 /// The correspondences of `points` at pose T: `search` finds a map point's neighbours, `make`
-/// the residual of a fitted line or plane (or nothing). A point measured `times[i]` after the
-/// stamp moves (1 + times[i] / period_s) times as far as the pose (point_residuals.hpp); with
-/// period_s 0 the points are rigid.
+/// the residual of a fitted line or plane (or nothing), `cache` keeps them between the outer
+/// loops. A point measured `times[i]` after the stamp moves (1 + times[i] / period_s) times as
+/// far as the pose (point_residuals.hpp); with period_s 0 the points are rigid.
 template <class Residual, class Search, class Make>
 std::vector<Residual> match(const std::vector<Eigen::Vector3f>& points,
                             const std::vector<float>& times, double period_s,
-                            const Eigen::Isometry3d& T, Search&& search, Make&& make) {
+                            const Eigen::Isometry3d& T, MatchCache<Residual>& cache,
+                            Search&& search, Make&& make) {
+  if (cache.fit.size() != points.size()) {
+    cache.searched_at.assign(points.size(), Eigen::Vector3d::Zero());
+    cache.fit.assign(points.size(), std::nullopt);
+    cache.searched.assign(points.size(), 0);
+  }
   // The nearest-neighbour searches dominate: both cores share them, the order stays the scan's.
   std::vector<std::optional<Residual>> found(points.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      std::vector<Eigen::Vector3d> near;
-                      near.reserve(kNeighbours);
-                      for (size_t i = range.begin(); i < range.end(); ++i) {
-                        const Eigen::Vector3d p = points[i].cast<double>();
-                        const Eigen::Vector3d x = T * p;
-                        search(x, near);
-                        if (near.size() != static_cast<size_t>(kNeighbours)) continue;
-                        found[i] = make(p, near);
-                        if (found[i] && period_s > 0.0) {
-                          found[i]->anchor = x;
-                          found[i]->gain = 1.0 + static_cast<double>(times[i]) / period_s;
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, points.size(), 64),
+      [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<Eigen::Vector3d> near;
+        near.reserve(kNeighbours);
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+          const Eigen::Vector3d p = points[i].cast<double>();
+          const Eigen::Vector3d x = T * p;
+          if (!cache.searched[i] || (x - cache.searched_at[i]).norm() >= kReuseDistanceM) {
+            search(x, near);
+            cache.fit[i] = near.size() == static_cast<size_t>(kNeighbours)
+                               ? make(near)
+                               : std::optional<Residual>();
+            cache.searched_at[i] = x;
+            cache.searched[i] = 1;
+          }
+          if (!cache.fit[i]) continue;
+          found[i] = cache.fit[i];
+          found[i]->point = p;
+          if (period_s > 0.0) {
+            found[i]->anchor = x;
+            found[i]->gain = 1.0 + static_cast<double>(times[i]) / period_s;
+          }
+        }
+      });
   std::vector<Residual> out;
   for (const auto& f : found) {
     if (f) out.push_back(*f);
@@ -112,35 +140,38 @@ std::vector<Residual> match(const std::vector<Eigen::Vector3f>& points,
   return out;
 }
 
+/// The searches' results of one registration, kept between its outer loops.
+struct AssociationCache {
+  MatchCache<PointToLine> lines;
+  MatchCache<PointToPlane> planes;
+};
+
 Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& points, double period_s,
-                          const Eigen::Isometry3d& T, double max_distance) {
+                          const Eigen::Isometry3d& T, double max_distance,
+                          AssociationCache& cache) {
   Correspondences c;
   c.lines = match<PointToLine>(
-      points.edges, points.edge_time_s, period_s, T,
+      points.edges, points.edge_time_s, period_s, T, cache.lines,
       [&](const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& near) {
         map.nearest_edges(x, kNeighbours, max_distance, near);
       },
-      [](const Eigen::Vector3d& p,
-         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToLine> {
+      [](const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToLine> {
         const auto line = fit_line(near);
         if (!line) return std::nullopt;
         PointToLine residual;
-        residual.point = p;
         residual.line_point = line->point;
         residual.direction = line->direction;
         return residual;
       });
   c.planes = match<PointToPlane>(
-      points.surfaces, points.surface_time_s, period_s, T,
+      points.surfaces, points.surface_time_s, period_s, T, cache.planes,
       [&](const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& near) {
         map.nearest_surfaces(x, kNeighbours, max_distance, near);
       },
-      [](const Eigen::Vector3d& p,
-         const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
+      [](const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
         const auto plane = fit_plane(near);
         if (!plane) return std::nullopt;
         PointToPlane residual;
-        residual.point = p;
         residual.normal = plane->normal;
         residual.offset = plane->offset;
         return residual;
@@ -242,9 +273,11 @@ Eigen::Isometry3d solve(const Correspondences& c, const Eigen::Isometry3d& pose,
   options.num_threads = tbb::this_task_arena::max_concurrency();
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
-  options.function_tolerance = 1e-14;
-  options.gradient_tolerance = 1e-16;
-  options.parameter_tolerance = 1e-14;
+  // Ceres' own tolerances: a relative change of the cost below 1e-6 or of the pose below
+  // 1e-8 ends the solve (tighter ones only spent iterations on digits below the noise).
+  options.function_tolerance = 1e-6;
+  options.gradient_tolerance = 1e-10;
+  options.parameter_tolerance = 1e-8;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
@@ -275,13 +308,14 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
 
   Eigen::Isometry3d pose = prediction;
   Correspondences c;
+  AssociationCache cache;
   int iterations = 0;
   for (int step = 0; step < settings.optimization_steps; ++step) {
     const auto association_start = Clock::now();
     const TimedFeatures points =
         deskew ? deskewed(raw, start.previous.inverse() * pose, start.elapsed_s) : raw;
     c = associate(map, points, deskew ? start.elapsed_s : 0.0, pose,
-                  settings.max_correspondence_distance_m);
+                  settings.max_correspondence_distance_m, cache);
     result.timing.association_ms += ms_since(association_start);
     if (c.size() < kMinCorrespondences) {
       result.edge_correspondences = c.lines.size();
