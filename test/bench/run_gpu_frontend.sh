@@ -38,3 +38,18 @@ for seq in "parking drive 120" "lab walk 120"; do
     summary "$out/map_$1_$2_$run.json" "$1 $2 $run"
   done
 done
+# The front end alone on 2 cores (features + registration per scan): simulated OS1-128
+# sequences and the real OS1-128 pcap when it was packed.
+for seq in "parking drive" "lab walk"; do
+  set -- $seq
+  taskset -c 0,1 "$bin/featsense" bench odometry --quiet --scene "$1" --path "$2" --scans 150 \
+    --json "$out/bench_odometry_$1_$2.json" > /dev/null
+  python3 -c "import json, sys; d = json.load(open(sys.argv[1])); print(sys.argv[2], '2 cores: features %.1f registration %.1f total %.1f ms median (p95 %.1f), ATE %.4f' % (d['features']['median_ms'], d['registration']['median_ms'], d['total']['median_ms'], d['total']['p95_ms'], d['ape_rmse_m']))" "$out/bench_odometry_$1_$2.json" "bench odometry $1 $2"
+done
+pcap=/tmp/bundle/OS-1-128_v2.3.0_1024x10_lb_n3.pcap
+if [ -f "$pcap" ]; then
+  taskset -c 0,1 "$bin/featsense" bench odometry --quiet --input "$pcap" \
+    --meta /tmp/bundle/OS-1-128_v2.3.0_1024x10.json --json "$out/bench_odometry_os1.json" > /dev/null
+  python3 -c "import json, sys; d = json.load(open(sys.argv[1])); print('bench odometry os1 pcap 2 cores: total %.1f ms (%d timed scan)' % (d['total']['median_ms'], d['timed_scans']))" "$out/bench_odometry_os1.json"
+fi
+
