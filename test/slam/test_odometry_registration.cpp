@@ -8,11 +8,15 @@
 #include <random>
 #include <vector>
 
+#include "common/test_poses.hpp"
 #include "featsense/config/config.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
+
+using test::angle_between;
+using test::pose;
 
 /// A scene of planes and lines in the map frame, sampled densely.
 struct Scene {
@@ -85,8 +89,6 @@ FeatureSet observe(const Scene& scene, const Eigen::Isometry3d& T_map_sensor, in
   return f;
 }
 
-Eigen::Isometry3d pose(double yaw, double pitch, double roll, const Eigen::Vector3d& t);
-
 /// The fraction s of a motion at constant velocity: rotation angle and translation scaled.
 Eigen::Isometry3d part_of(const Eigen::Isometry3d& motion, double s) {
   const Eigen::AngleAxisd turn(Eigen::Matrix3d(motion.rotation()));
@@ -118,20 +120,6 @@ FeatureSet observe_moving(const Scene& scene, const Eigen::Isometry3d& T_map_sen
   for (const auto& p : scene.surfaces) measure(p, f.surfaces, f.surface_time_s);
   for (const auto& p : scene.edges) measure(p, f.edges, f.edge_time_s);
   return f;
-}
-
-Eigen::Isometry3d pose(double yaw, double pitch, double roll, const Eigen::Vector3d& t) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = t;
-  return T;
-}
-
-double angle_between(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
-  return Eigen::AngleAxisd(Eigen::Matrix3d(a.rotation().transpose() * b.rotation())).angle();
 }
 
 /// The poses are expressed with the first scan's sensor frame as the map.

@@ -1,0 +1,224 @@
+#include "featsense/slam/refine/vgicp.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace featsense::slam::refine {
+namespace {
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+VgicpLinearization& operator+=(VgicpLinearization& a, const VgicpLinearization& b) {
+  a.cost += b.cost;
+  a.gradient += b.gradient;
+  a.hessian += b.hessian;
+  a.terms += b.terms;
+  return a;
+}
+
+/// T <- (Exp(w) R, Exp(w) t + v) for the tangent step [w, v].
+Eigen::Isometry3d apply_left(const Eigen::Isometry3d& T, const Vector6d& step) {
+  const Eigen::Vector3d w = step.head<3>();
+  const double angle = w.norm();
+  const Eigen::Matrix3d turn = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                                           : Eigen::Matrix3d::Identity();
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = turn * T.rotation();
+  out.translation() = turn * T.translation() + step.tail<3>();
+  return out;
+}
+
+struct Fit {
+  double fitness_m = 0.0;
+  double inlier_fraction = 0.0;
+};
+
+Fit fit_at(const VoxelGaussians& target, const GaussianCloud& source, const Eigen::Isometry3d& T,
+           double inlier_distance_m) {
+  struct Sum {
+    double squared = 0.0;
+    size_t inliers = 0;
+  };
+  const Sum sum = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, source.size(), 512), Sum{},
+      [&](const tbb::blocked_range<size_t>& range, Sum s) {
+        std::vector<const VoxelGaussian*> near;
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+          const Eigen::Vector3d x = T * source.points[i];
+          target.near(x, near);
+          double best = std::numeric_limits<double>::infinity();
+          for (const VoxelGaussian* v : near)
+            best = std::min(best, std::abs(v->normal.dot(x - v->mean)));
+          if (best < inlier_distance_m) {
+            s.squared += best * best;
+            ++s.inliers;
+          }
+        }
+        return s;
+      },
+      [](Sum a, const Sum& b) {
+        a.squared += b.squared;
+        a.inliers += b.inliers;
+        return a;
+      });
+  Fit fit;
+  if (sum.inliers > 0) fit.fitness_m = std::sqrt(sum.squared / static_cast<double>(sum.inliers));
+  if (source.size() > 0) {
+    fit.inlier_fraction = static_cast<double>(sum.inliers) / static_cast<double>(source.size());
+  }
+  return fit;
+}
+
+}  // namespace
+
+namespace {
+
+/// A source point and a voxel around it: one term of the cost.
+struct Correspondence {
+  uint32_t point;
+  const VoxelGaussian* voxel;
+};
+
+/// The terms at pose T: each source point with the voxels around it (voxel_gaussians.hpp).
+std::vector<Correspondence> correspond(const VoxelGaussians& target, const GaussianCloud& source,
+                                       const Eigen::Isometry3d& T) {
+  std::vector<std::vector<const VoxelGaussian*>> per_point(source.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, source.size(), 512),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i < range.end(); ++i) {
+                        target.near(T * source.points[i], per_point[i]);
+                      }
+                    });
+  std::vector<Correspondence> out;
+  for (size_t i = 0; i < per_point.size(); ++i) {
+    for (const VoxelGaussian* v : per_point[i]) out.push_back({static_cast<uint32_t>(i), v});
+  }
+  return out;
+}
+
+/// The cost of the fixed terms at T and, when `derivatives`, its gradient and Hessian.
+VgicpLinearization evaluate(const GaussianCloud& source, const std::vector<Correspondence>& terms,
+                            const Eigen::Isometry3d& T, bool derivatives) {
+  const Eigen::Matrix3d R = T.rotation();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, terms.size(), 512), VgicpLinearization{},
+      [&](const tbb::blocked_range<size_t>& range, VgicpLinearization sum) {
+        for (size_t k = range.begin(); k < range.end(); ++k) {
+          const Correspondence& c = terms[k];
+          const Eigen::Vector3d x = T * source.points[c.point];
+          const Eigen::Vector3d e = c.voxel->mean - x;
+          const Eigen::LLT<Eigen::Matrix3d> llt(c.voxel->covariance +
+                                                R * source.covariances[c.point] * R.transpose());
+          if (llt.info() != Eigen::Success) continue;
+          const Eigen::Matrix3d W = llt.solve(Eigen::Matrix3d::Identity());
+          sum.cost += e.dot(W * e);
+          ++sum.terms;
+          if (!derivatives) continue;
+          // e(step) = mu - (Exp(w) x + v) = e + [x]x w - v to first order.
+          Eigen::Matrix<double, 3, 6> J;
+          J.leftCols<3>() = skew(x);
+          J.rightCols<3>() = -Eigen::Matrix3d::Identity();
+          const Eigen::Matrix<double, 6, 3> JtW = J.transpose() * W;
+          sum.gradient += JtW * e;
+          sum.hessian += JtW * J;
+        }
+        return sum;
+      },
+      [](VgicpLinearization a, const VgicpLinearization& b) { return a += b; });
+}
+
+}  // namespace
+
+VgicpLinearization linearize(const VoxelGaussians& target, const GaussianCloud& source,
+                             const Eigen::Isometry3d& T) {
+  return evaluate(source, correspond(target, source, T), T, true);
+}
+
+VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& source,
+                            const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+  VgicpResult result;
+  result.T_target_source = guess;
+  if (source.size() == 0 || target.size() == 0 || !guess.matrix().allFinite()) return result;
+  Eigen::Isometry3d T = guess;
+  double lambda = 1e-4;
+  VgicpLinearization at;
+  for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
+    result.iterations = iteration + 1;
+    // The terms are found again at every iteration and held while the steps are tried, so
+    // that a step is judged on the same terms as the cost it is compared with.
+    const std::vector<Correspondence> terms = correspond(target, source, T);
+    at = evaluate(source, terms, T, true);
+    if (at.terms < 6) break;  // too few correspondences to fix a pose
+    bool accepted = false;
+    bool settled = false;
+    Vector6d step = Vector6d::Zero();
+    // Levenberg-Marquardt: damp the Gauss-Newton step until it lowers the cost.
+    for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
+      Matrix6d damped = at.hessian;
+      damped.diagonal() += lambda * at.hessian.diagonal().cwiseMax(1e-9);
+      step = damped.ldlt().solve(-at.gradient);
+      if (!step.allFinite()) break;
+      const Eigen::Isometry3d candidate = apply_left(T, step);
+      const VgicpLinearization next = evaluate(source, terms, candidate, false);
+      if (next.cost <= at.cost) {
+        // A step that lowers the cost by a millionth or less: the terms are at their minimum
+        // (at fine voxels the points keep trading voxels by fractions of a millimetre).
+        settled = at.cost - next.cost <= 1e-6 * at.cost;
+        T = candidate;
+        lambda = std::max(lambda / 10.0, 1e-9);
+        accepted = true;
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!accepted) {
+      // No damped step lowers the cost of these terms: at their minimum.
+      result.converged = step.allFinite();
+      break;
+    }
+    if (settled || (step.tail<3>().norm() < settings.step_tolerance_m &&
+                    10.0 * step.head<3>().norm() < settings.step_tolerance_m)) {
+      result.converged = true;
+      break;
+    }
+  }
+  if (!T.matrix().allFinite()) return VgicpResult{guess, false, result.iterations, 0.0, 0.0, {}};
+  result.T_target_source = T;
+  result.hessian = linearize(target, source, T).hessian;
+  const Fit fit = fit_at(target, source, T, settings.inlier_distance_m);
+  result.fitness_m = fit.fitness_m;
+  result.inlier_fraction = fit.inlier_fraction;
+  return result;
+}
+
+VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+  VgicpResult result;
+  result.T_target_source = guess;
+  for (const double voxel_m : settings.voxel_sizes_m) {
+    const VgicpResult level =
+        align_to_voxels(VoxelGaussians(target, voxel_m), source, result.T_target_source, settings);
+    const int iterations = result.iterations + level.iterations;
+    result = level;
+    result.iterations = iterations;
+  }
+  if (!settings.voxel_sizes_m.empty() && target.size() > 0) {
+    const Fit fit = fit_at(VoxelGaussians(target, settings.fitness_voxel_m), source,
+                           result.T_target_source, settings.inlier_distance_m);
+    result.fitness_m = fit.fitness_m;
+    result.inlier_fraction = fit.inlier_fraction;
+  }
+  return result;
+}
+
+}  // namespace featsense::slam::refine

@@ -1,0 +1,175 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <vector>
+
+#include "common/test_data.hpp"
+#include "common/test_poses.hpp"
+#include "featsense/slam/io/open_scan_source.hpp"
+#include "featsense/slam/refine/vgicp.hpp"
+#include "featsense/slam/sim/scene_library.hpp"
+
+namespace featsense::slam::refine {
+namespace {
+
+using test::pose;
+
+/// `count` points of the scene's surface within `radius` of `centre`, area-weighted, with
+/// Gaussian noise of `sigma` along each axis.
+std::vector<Eigen::Vector3f> sample_scene(const mesh::TriangleMesh& scene,
+                                          const Eigen::Vector3f& centre, float radius, int count,
+                                          float sigma, uint32_t seed) {
+  std::vector<double> cumulative;
+  std::vector<size_t> triangles;
+  double total = 0.0;
+  for (size_t t = 0; t < scene.triangles.size(); ++t) {
+    const Eigen::Vector3i& f = scene.triangles[t];
+    const Eigen::Vector3f a = scene.vertices[f[0]], b = scene.vertices[f[1]],
+                          c = scene.vertices[f[2]];
+    if (((a + b + c) / 3.0f - centre).norm() > radius) continue;
+    total += 0.5 * static_cast<double>((b - a).cross(c - a).norm());
+    cumulative.push_back(total);
+    triangles.push_back(t);
+  }
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> pick(0.0, total);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::normal_distribution<float> noise(0.0f, sigma);
+  std::vector<Eigen::Vector3f> points;
+  while (static_cast<int>(points.size()) < count) {
+    const size_t k = static_cast<size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), pick(rng)) - cumulative.begin());
+    const Eigen::Vector3i& f = scene.triangles[triangles[std::min(k, triangles.size() - 1)]];
+    float r1 = u(rng), r2 = u(rng);
+    if (r1 + r2 > 1.0f) {
+      r1 = 1.0f - r1;
+      r2 = 1.0f - r2;
+    }
+    const Eigen::Vector3f p = scene.vertices[f[0]] +
+                              r1 * (scene.vertices[f[1]] - scene.vertices[f[0]]) +
+                              r2 * (scene.vertices[f[2]] - scene.vertices[f[0]]);
+    points.push_back(p + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
+  }
+  return points;
+}
+
+double angle_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return test::angle_between(a, b) * 180.0 / M_PI;
+}
+
+std::vector<Eigen::Vector3f> moved(const std::vector<Eigen::Vector3f>& points,
+                                   const Eigen::Isometry3d& T) {
+  std::vector<Eigen::Vector3f> out;
+  for (const auto& p : points) out.push_back((T * p.cast<double>()).cast<float>());
+  return out;
+}
+
+TEST(Vgicp, GradientAndHessianMatchTheCost) {
+  const mesh::TriangleMesh lab = build_scene("lab");
+  const auto a = sample_scene(lab, {0, 0, 1.5f}, 8.0f, 4000, 0.01f, 1);
+  const auto b = sample_scene(lab, {0, 0, 1.5f}, 8.0f, 1000, 0.01f, 2);
+  const VoxelGaussians target(with_covariances(a, 10), 1.0);
+  GaussianCloud source = with_covariances(b, 10);
+  // Without source covariances the weights do not turn with the pose: the cost is then
+  // exactly the quadratic form whose derivatives linearize() gives.
+  for (auto& c : source.covariances) c.setZero();
+  const Eigen::Isometry3d T = pose(0.02, -0.01, 0.01, {0.05, -0.03, 0.02});
+  const VgicpLinearization at = linearize(target, source, T);
+  ASSERT_GT(at.terms, 500u);
+  const double h = 1e-6;
+  auto step = [&](int k, double s) {
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    d[k] = s;
+    const Eigen::Vector3d w = d.head<3>();
+    Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+    const Eigen::Matrix3d turn =
+        w.norm() > 0 ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
+                     : Eigen::Matrix3d::Identity();
+    out.linear() = turn * T.rotation();
+    out.translation() = turn * T.translation() + d.tail<3>();
+    return linearize(target, source, out).cost;
+  };
+  for (int k = 0; k < 6; ++k) {
+    const double numeric = (step(k, h) - step(k, -h)) / (2 * h);
+    EXPECT_NEAR(numeric, 2.0 * at.gradient[k], 1e-4 * std::max(1.0, std::abs(numeric))) << k;
+  }
+  // The Gauss-Newton Hessian is symmetric and positive definite on a 3D scene.
+  EXPECT_LT((at.hessian - at.hessian.transpose()).norm(), 1e-9 * at.hessian.norm());
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix6d>(at.hessian).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST(Vgicp, RecoversAKnownMotionFromHalfAMetreAndFiveDegrees) {
+  const mesh::TriangleMesh lab = build_scene("lab");
+  // Two independent noisy samplings of the same place; the source seen from a sensor moved
+  // by `truth` (target <- source).
+  const auto a = sample_scene(lab, {0, 0, 1.5f}, 10.0f, 30000, 0.01f, 3);
+  const auto b = sample_scene(lab, {0, 0, 1.5f}, 10.0f, 15000, 0.01f, 4);
+  const Eigen::Isometry3d truth = pose(0.3, 0.02, -0.01, {1.2, -0.4, 0.1});
+  const int k = 20;
+  const GaussianCloud target_cloud = with_covariances(a, k);
+  const GaussianCloud source = with_covariances(moved(b, truth.inverse()), k);
+  const Eigen::Isometry3d guess = truth * pose(5.0 * M_PI / 180.0, 0, 0, {0.4, -0.3, 0.0});
+  ASSERT_NEAR((guess.translation() - truth.translation()).norm(), 0.5, 0.05);
+  const VgicpResult r = align(target_cloud, source, guess);
+  RecordProperty("error_m",
+                 std::to_string((r.T_target_source.translation() - truth.translation()).norm()));
+  RecordProperty("error_deg", std::to_string(angle_deg(r.T_target_source, truth)));
+  RecordProperty("fitness_m", std::to_string(r.fitness_m));
+  RecordProperty("inliers", std::to_string(r.inlier_fraction));
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT((r.T_target_source.translation() - truth.translation()).norm(), 0.01)
+      << r.T_target_source.translation().transpose();
+  EXPECT_LT(angle_deg(r.T_target_source, truth), 0.1);
+  EXPECT_GT(r.inlier_fraction, 0.9);
+  EXPECT_LT(r.fitness_m, 0.03);  // the samplings' noise: 1 cm per axis
+}
+
+TEST(Vgicp, EmptyCloudsGiveTheGuessNotConverged) {
+  const Eigen::Isometry3d guess = pose(0.1, 0, 0, {1, 2, 3});
+  const VgicpResult r = align(GaussianCloud{}, GaussianCloud{}, guess);
+  EXPECT_FALSE(r.converged);
+  EXPECT_TRUE(r.T_target_source.isApprox(guess));
+}
+
+/// The two real HDL-32E scans of data/velodyne and the motion between them.
+TEST(Vgicp, RealHdl32PairFromTheIdentity) {
+  FEATSENSE_SHARED_FILE(dir, "velodyne");
+  FEATSENSE_SHARED_FILE(relative_file, "velodyne/relative.txt");
+  auto read_points = [&](const char* name) {
+    SourceOptions options;
+    options.sensor_preset = "hdl32";
+    auto source = open_scan_source((dir / name).string(), options);
+    std::vector<Eigen::Vector3f> points;
+    while (auto scan = source->next()) {
+      for (size_t i = 0; i < scan->size(); ++i)
+        if (scan->valid[i]) points.push_back(scan->xyz[i]);
+    }
+    return points;
+  };
+  const auto first = read_points("251370668.pcd");
+  const auto second = read_points("251371071.pcd");
+  ASSERT_GT(first.size(), 10000u);
+  Eigen::Matrix4d relative;
+  std::ifstream file(relative_file);
+  for (int i = 0; i < 16; ++i) file >> relative(i / 4, i % 4);
+  const Eigen::Isometry3d truth(relative);
+  const int k = 20;
+  const GaussianCloud target_cloud = with_covariances(first, k);
+  const GaussianCloud source = with_covariances(second, k);
+  const VgicpResult r = align(target_cloud, source, Eigen::Isometry3d::Identity());
+  RecordProperty("error_m",
+                 std::to_string((r.T_target_source.translation() - truth.translation()).norm()));
+  RecordProperty("error_deg", std::to_string(angle_deg(r.T_target_source, truth)));
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT((r.T_target_source.translation() - truth.translation()).norm(), 0.03)
+      << r.T_target_source.translation().transpose() << " vs " << truth.translation().transpose();
+  EXPECT_LT(angle_deg(r.T_target_source, truth), 0.2);
+}
+
+}  // namespace
+}  // namespace featsense::slam::refine
