@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace featsense::slam::refine {
@@ -144,20 +145,24 @@ VgicpLinearization linearize(const VoxelGaussians& target, const GaussianCloud& 
   return evaluate(source, correspond(target, source, T), T, true);
 }
 
-VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& source,
-                            const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+namespace {
+
+/// The pose that minimises the cost over `target`'s voxels from `guess`, by Levenberg-
+/// Marquardt: fills the pose, converged and iterations (the diagnostics that need a second
+/// look at the result are describe()'s).
+VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
   VgicpResult result;
   result.T_target_source = guess;
   if (source.size() == 0 || target.size() == 0 || !guess.matrix().allFinite()) return result;
   Eigen::Isometry3d T = guess;
   double lambda = 1e-4;
-  VgicpLinearization at;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     result.iterations = iteration + 1;
     // The terms are found again at every iteration and held while the steps are tried, so
     // that a step is judged on the same terms as the cost it is compared with.
     const std::vector<Correspondence> terms = correspond(target, source, T);
-    at = evaluate(source, terms, T, true);
+    const VgicpLinearization at = evaluate(source, terms, T, true);
     if (at.terms < 6) break;  // too few correspondences to fix a pose
     bool accepted = false;
     bool settled = false;
@@ -194,10 +199,27 @@ VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& s
   }
   if (!T.matrix().allFinite()) return VgicpResult{guess, false, result.iterations, 0.0, 0.0, {}};
   result.T_target_source = T;
-  result.hessian = linearize(target, source, T).hessian;
-  const Fit fit = fit_at(target, source, T, settings.inlier_distance_m);
+  return result;
+}
+
+/// The result's Hessian over `solved` (the voxels it was solved on) and its fitness and
+/// inliers over `measured`.
+void describe(VgicpResult& result, const VoxelGaussians& solved, const VoxelGaussians& measured,
+              const GaussianCloud& source, const VgicpSettings& settings) {
+  result.hessian = linearize(solved, source, result.T_target_source).hessian;
+  const Fit fit = fit_at(measured, source, result.T_target_source, settings.inlier_distance_m);
   result.fitness_m = fit.fitness_m;
   result.inlier_fraction = fit.inlier_fraction;
+}
+
+}  // namespace
+
+VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& source,
+                            const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+  VgicpResult result = solve(target, source, guess, settings);
+  if (source.size() > 0 && target.size() > 0 && result.T_target_source.matrix().allFinite()) {
+    describe(result, target, target, source, settings);
+  }
   return result;
 }
 
@@ -205,18 +227,15 @@ VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
                   const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
   VgicpResult result;
   result.T_target_source = guess;
+  std::optional<VoxelGaussians> finest;
   for (const double voxel_m : settings.voxel_sizes_m) {
-    const VgicpResult level =
-        align_to_voxels(VoxelGaussians(target, voxel_m), source, result.T_target_source, settings);
-    const int iterations = result.iterations + level.iterations;
-    result = level;
-    result.iterations = iterations;
+    finest.emplace(target, voxel_m);
+    const int iterations = result.iterations;
+    result = solve(*finest, source, result.T_target_source, settings);
+    result.iterations += iterations;
   }
-  if (!settings.voxel_sizes_m.empty() && target.size() > 0) {
-    const Fit fit = fit_at(VoxelGaussians(target, settings.fitness_voxel_m), source,
-                           result.T_target_source, settings.inlier_distance_m);
-    result.fitness_m = fit.fitness_m;
-    result.inlier_fraction = fit.inlier_fraction;
+  if (finest && source.size() > 0 && target.size() > 0) {
+    describe(result, *finest, VoxelGaussians(target, settings.fitness_voxel_m), source, settings);
   }
   return result;
 }
