@@ -19,8 +19,6 @@ constexpr int kMaxRestartRounds = 12;
 /// The restart's rounds converge slowly: it stops on a finer change than a registration.
 constexpr double kRestartSettledM = 2e-5;
 
-bool finite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
-
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -51,10 +49,10 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
     result.elapsed_s = static_cast<double>(features.stamp_ns - last_stamp_ns_) * 1e-9;
     start.elapsed_s = std::max(result.elapsed_s, 0.0);
     if (result.elapsed_s > 0.0 && last_motion_s_ > 0.0) {
-      start.prediction = last_pose_ * interpolate_pose(Eigen::Isometry3d::Identity(), last_motion_,
-                                                       result.elapsed_s / last_motion_s_);
+      start.prediction =
+          last_pose_ * motion_fraction(last_motion_, result.elapsed_s / last_motion_s_);
     }
-    if (!finite(start.prediction)) start.prediction = last_pose_;
+    if (!start.prediction.matrix().allFinite()) start.prediction = last_pose_;
   }
 
   Eigen::Isometry3d pose = start.prediction;

@@ -14,11 +14,6 @@
 namespace featsense::slam::odometry {
 namespace {
 
-/// The fraction `s` of a rigid motion at constant velocity (negative: before it began).
-Eigen::Isometry3d part_of(const Eigen::Isometry3d& motion, double s) {
-  return interpolate_pose(Eigen::Isometry3d::Identity(), motion, s);
-}
-
 double milliseconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
@@ -67,20 +62,21 @@ class FeatureOdometryLocator final : public OdometryLocator {
       last_period_s_ = result.elapsed_s;
     }
     const bool moving = last_period_s_ > 0.0;
-    const double fit_time_s = mean_time(found.edge_time_s, found.surface_time_s);
 
     ScanPlacement placed;
     placed.sequence = scan.sequence;
     placed.stamp_ns = scan.stamp_ns;
     placed.T_map_sensor = T_map_first_ * result.T_map_sensor;
-    if (moving && !deskew_)
+    if (moving && !deskew_) {
+      const double fit_time_s = mean_time(found.edge_time_s, found.surface_time_s);
       placed.T_map_sensor =
-          placed.T_map_sensor * part_of(last_motion_, -fit_time_s / last_period_s_);
+          placed.T_map_sensor * motion_fraction(last_motion_, -fit_time_s / last_period_s_);
+    }
     placed.diagnostics = result.diagnostics;
     if (deskew_ && moving) {
       placed.column_T_map_sensor = column_poses(scan, placed.T_map_sensor, [&](double t) {
         return std::optional<Eigen::Isometry3d>(placed.T_map_sensor *
-                                                part_of(last_motion_, t / last_period_s_));
+                                                motion_fraction(last_motion_, t / last_period_s_));
       });
     }
     return placed;

@@ -11,7 +11,7 @@ void deskew_points(const std::vector<Eigen::Vector3f>& raw, const std::vector<fl
                    std::vector<Eigen::Vector3f>& out) {
   for (size_t i = 0; i < raw.size(); ++i) {
     const double s = static_cast<double>(times[i]) / period_s;
-    const Eigen::Isometry3d part = interpolate_pose(Eigen::Isometry3d::Identity(), motion, s);
+    const Eigen::Isometry3d part = motion_fraction(motion, s);
     out[i] = (part * raw[i].cast<double>()).cast<float>();
   }
 }

@@ -52,4 +52,8 @@ std::optional<Eigen::Isometry3d> PoseInterpolator::at(int64_t stamp_ns) const {
   return interpolate_pose(poses[i - 1], poses[i], f);
 }
 
+Eigen::Isometry3d motion_fraction(const Eigen::Isometry3d& motion, double s) {
+  return interpolate_pose(Eigen::Isometry3d::Identity(), motion, s);
+}
+
 }  // namespace featsense::slam

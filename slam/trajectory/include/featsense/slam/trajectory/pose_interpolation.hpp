@@ -34,4 +34,8 @@ class PoseInterpolator {
 Eigen::Isometry3d interpolate_pose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
                                    double f);
 
+/// The fraction `s` of a rigid motion made at constant velocity: interpolate_pose from the
+/// identity (s < 0: before the motion began, s > 1: continued beyond it).
+Eigen::Isometry3d motion_fraction(const Eigen::Isometry3d& motion, double s);
+
 }  // namespace featsense::slam
