@@ -4,16 +4,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 
 namespace featsense::test {
 namespace {
-
-nlohmann::json read_json(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  return nlohmann::json::parse(file);
-}
 
 TEST(CliBenchFrontEnd, FeaturesAreTimedOnEverySimulatedScan) {
   const std::filesystem::path json = scratch_dir("cli_bench_features") / "bench.json";

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 
@@ -12,17 +13,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json report_of(const fs::path& out) {
-  std::ifstream file(out / "report.json");
-  return nlohmann::json::parse(file);
-}
-
 TEST(CliDemo, EstimatesThePosesAndScoresPathAndMesh) {
   const fs::path out = scratch_dir("cli_demo") / "estimated";
   const CommandResult r = run_featsense("demo -o " + out.string() + " --frames 8 --backend cpu");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("poses estimated by the odometry: ATE"), std::string::npos) << r.output;
-  const nlohmann::json report = report_of(out);
+  const nlohmann::json report = read_json(out / "report.json");
   ASSERT_TRUE(report.contains("odometry")) << report.dump(2);
   ASSERT_TRUE(report["eval"].contains("traj")) << report.dump(2);
   EXPECT_EQ(report["eval"]["traj"]["ape"]["count"].get<int>(), 8);
@@ -36,7 +32,7 @@ TEST(CliDemo, GtPosesMapsWithTheTruth) {
       run_featsense("demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mapped with the true poses"), std::string::npos) << r.output;
-  const nlohmann::json report = report_of(out);
+  const nlohmann::json report = read_json(out / "report.json");
   EXPECT_FALSE(report.contains("odometry"));
   EXPECT_FALSE(report["eval"].contains("traj"));
   EXPECT_TRUE(report["eval"].contains("mesh"));

@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/viewer_export/ply_mesh_io.hpp"
@@ -33,11 +34,6 @@ void write_circle_tum(const std::filesystem::path& path, int count, double stamp
   }
 }
 
-nlohmann::json parse_json_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
-
 TEST(CliEval, TrajReportsApeRpeAndPairsAsJson) {
   const auto dir = scratch_dir("cli_eval_traj");
   write_circle_tum(dir / "gt.tum", 300, 0.0, 0.0);
@@ -48,7 +44,7 @@ TEST(CliEval, TrajReportsApeRpeAndPairsAsJson) {
                     (dir / "aligned.tum").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("APE:"), std::string::npos) << r.output;
-  const nlohmann::json j = parse_json_file(dir / "e.json");
+  const nlohmann::json j = read_json(dir / "e.json");
   EXPECT_EQ(j["pairs"], 300);
   for (const char* key : {"rmse", "mean", "median", "std", "min", "max"}) {
     EXPECT_NEAR(j["ape"][key].get<double>(), std::string(key) == "std" ? 0.0 : 0.05, 1e-6) << key;
@@ -128,7 +124,7 @@ TEST(CliEval, MeshReportsAccuracyCompletenessAndWritesScalarFields) {
       "eval mesh " + (dir / "est.ply").string() + " " + (dir / "ref.ply").string() + " --json " +
       (dir / "m.json").string() + " --ply-out " + (dir / "d.ply").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = parse_json_file(dir / "m.json");
+  const nlohmann::json j = read_json(dir / "m.json");
   EXPECT_EQ(j["points"], 25);
   EXPECT_NEAR(j["accuracy"]["mean_abs"].get<double>(), 0.01, 1e-6);
   EXPECT_NEAR(j["accuracy"]["mean_signed"].get<double>(), 0.01, 1e-6);

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
@@ -45,11 +46,6 @@ class CliMap : public ::testing::Test {
   static fs::path* sequence_;
 };
 fs::path* CliMap::sequence_ = nullptr;
-
-nlohmann::json read_json(const fs::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
 
 size_t count_lines(const fs::path& path) {
   std::ifstream in(path);
@@ -203,7 +199,7 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
       run_featsense("map " + sequence() + " -o " + out.string() + " --end 11" + kSmallMap);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(count_lines(out / "trajectory.tum"), 12u);
-  const nlohmann::json report = nlohmann::json::parse(std::ifstream(out / "report.json"));
+  const nlohmann::json report = read_json(out / "report.json");
   ASSERT_TRUE(report.contains("odometry")) << report.dump(2);
   EXPECT_EQ(report["odometry"]["scans"].get<size_t>(), 12u);
   EXPECT_GT(report["odometry"]["features_per_scan"].get<double>(), 100.0);
@@ -223,7 +219,7 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
       run_featsense("map " + sequence() + " -o " + other.string() + " --end 5" + kSmallMap +
                     " --no-mesh --reference-trajectory " + gt());
   ASSERT_EQ(referenced.exit_code, 0) << referenced.output;
-  const nlohmann::json second = nlohmann::json::parse(std::ifstream(other / "report.json"));
+  const nlohmann::json second = read_json(other / "report.json");
   ASSERT_TRUE(second["eval"].contains("traj")) << second.dump(2);
   EXPECT_EQ(second["eval"]["traj"]["ape"]["count"].get<size_t>(), 6u);
   EXPECT_LT(second["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);

@@ -135,6 +135,23 @@ OdometrySettings defaults() { return from_config(config::Config{}); }
 
 constexpr int64_t kFrame = 100'000'000;  // 10 Hz
 
+/// A sensor moving by `step` per frame from `start` through `scene`, `scans` scans observed
+/// at rest (no motion within a sweep): every scan after the first converges, and its pose
+/// (in the first scan's frame) lies within `tolerance` (metres and radians) of the truth.
+void expect_follows(const Scene& scene, const Eigen::Isometry3d& start,
+                    const Eigen::Isometry3d& step, int scans, double tolerance) {
+  FeatureOdometry odometry(defaults());
+  Eigen::Isometry3d truth = start;
+  for (int i = 0; i < scans; ++i) {
+    const OdometryResult r = odometry.register_scan(observe(scene, truth, i * kFrame));
+    if (i > 0) {
+      EXPECT_TRUE(r.diagnostics.converged) << i << ": " << r.reason;
+      expect_pose_near(r.T_map_sensor, start.inverse() * truth, tolerance);
+    }
+    truth = truth * step;
+  }
+}
+
 TEST(OdometryRegistration, RecoversAKnownMotion) {
   const Scene room = box_room();
   const Eigen::Isometry3d start = pose(0.1, 0.0, 0.0, {0.5, 0.3, 1.5});
@@ -158,16 +175,7 @@ TEST(OdometryRegistration, FollowsAConstantVelocitySequence) {
   const Scene room = box_room();
   const Eigen::Isometry3d start = pose(0.0, 0.0, 0.0, {-3.0, 0.0, 1.5});
   const Eigen::Isometry3d step = pose(0.03, 0.0, 0.0, {0.25, 0.02, 0.0});  // 2.5 m/s, 0.3 rad/s
-  FeatureOdometry odometry(defaults());
-  Eigen::Isometry3d truth = start;
-  for (int i = 0; i < 8; ++i) {
-    const OdometryResult r = odometry.register_scan(observe(room, truth, i * kFrame));
-    if (i > 0) {
-      EXPECT_TRUE(r.diagnostics.converged) << i << ": " << r.reason;
-      expect_pose_near(r.T_map_sensor, start.inverse() * truth, 1e-6);
-    }
-    truth = truth * step;
-  }
+  expect_follows(room, start, step, 8, 1e-6);
 }
 
 /// A sensor moving at 5 m/s and 0.5 rad/s from the first scan on, each sweep smeared by half
@@ -313,20 +321,9 @@ TEST(OdometryRegistration, FollowsAHallSampledAtRandom) {
   for (int x = -15; x <= 15; x += 10) {
     for (int y = -10; y <= 10; y += 10) add_vertical_line(hall.edges, x, y, 0.3, 5.5, 0.15);
   }
-  FeatureOdometry odometry(defaults());
-  const Eigen::Isometry3d step = pose(0.02, 0, 0, {0.3, 0.05, 0});
-  const Eigen::Isometry3d start = pose(0, 0, 0, {-8, 0, 1.5});
-  Eigen::Isometry3d truth = start;
-  for (int i = 0; i < 30; ++i) {
-    const OdometryResult r = odometry.register_scan(observe(hall, truth, i * kFrame));
-    if (i > 0) {
-      EXPECT_TRUE(r.diagnostics.converged) << i << ": " << r.reason;
-      // Where the five nearest map points of a point near a corner span two walls, the plane
-      // is slightly off: millimetres over 30 scans, not a drift.
-      expect_pose_near(r.T_map_sensor, start.inverse() * truth, 5e-3);
-    }
-    truth = truth * step;
-  }
+  // Where the five nearest map points of a point near a corner span two walls, the plane is
+  // slightly off: millimetres over 30 scans, not a drift.
+  expect_follows(hall, pose(0, 0, 0, {-8, 0, 1.5}), pose(0.02, 0, 0, {0.3, 0.05, 0}), 30, 5e-3);
 }
 
 }  // namespace
