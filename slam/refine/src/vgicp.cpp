@@ -39,13 +39,10 @@ Eigen::Isometry3d apply_left(const Eigen::Isometry3d& T, const Vector6d& step) {
   return out;
 }
 
-struct Fit {
-  double fitness_m = 0.0;
-  double inlier_fraction = 0.0;
-};
+}  // namespace
 
-Fit fit_at(const VoxelGaussians& target, const GaussianCloud& source, const Eigen::Isometry3d& T,
-           double inlier_distance_m) {
+VgicpFit measure_fit(const VoxelGaussians& target, const GaussianCloud& source,
+                     const Eigen::Isometry3d& T, double inlier_distance_m) {
   struct Sum {
     double squared = 0.0;
     size_t inliers = 0;
@@ -72,15 +69,13 @@ Fit fit_at(const VoxelGaussians& target, const GaussianCloud& source, const Eige
         a.inliers += b.inliers;
         return a;
       });
-  Fit fit;
+  VgicpFit fit;
   if (sum.inliers > 0) fit.fitness_m = std::sqrt(sum.squared / static_cast<double>(sum.inliers));
   if (source.size() > 0) {
     fit.inlier_fraction = static_cast<double>(sum.inliers) / static_cast<double>(source.size());
   }
   return fit;
 }
-
-}  // namespace
 
 namespace {
 
@@ -147,22 +142,57 @@ VgicpLinearization linearize(const VoxelGaussians& target, const GaussianCloud& 
 
 namespace {
 
-/// The pose that minimises the cost over `target`'s voxels from `guess`, by Levenberg-
-/// Marquardt: fills the pose, converged and iterations (the diagnostics that need a second
-/// look at the result are describe()'s).
-VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
-                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
-  VgicpResult result;
-  result.T_target_source = guess;
-  if (source.size() == 0 || target.size() == 0 || !guess.matrix().allFinite()) return result;
-  Eigen::Isometry3d T = guess;
+/// One source of a registration: its cloud, its pose (updated as the solve goes) and its
+/// share of each step (1 for a lone source).
+struct Part {
+  const GaussianCloud* cloud;
+  Eigen::Isometry3d T;
+  double share;
+};
+
+/// The cost of all parts over their fixed terms and, when `derivatives`, its gradient and
+/// Hessian in the shared step (a part's step is its share of it).
+VgicpLinearization evaluate_parts(const std::vector<Part>& parts,
+                                  const std::vector<std::vector<Correspondence>>& terms,
+                                  const std::vector<Eigen::Isometry3d>& poses, bool derivatives) {
+  VgicpLinearization sum;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const VgicpLinearization part = evaluate(*parts[i].cloud, terms[i], poses[i], derivatives);
+    const double s = parts[i].share;
+    sum.cost += part.cost;
+    sum.terms += part.terms;
+    sum.gradient += s * part.gradient;
+    sum.hessian += s * s * part.hessian;
+  }
+  return sum;
+}
+
+/// The parts' poses after a shared step.
+std::vector<Eigen::Isometry3d> stepped(const std::vector<Part>& parts, const Vector6d& step) {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(parts.size());
+  for (const Part& part : parts) poses.push_back(apply_left(part.T, part.share * step));
+  return poses;
+}
+
+/// The steps that minimise the cost of `parts` over `target`'s voxels from their poses, by
+/// Levenberg-Marquardt; the parts' poses are updated. Returns the steps taken, for poses
+/// that share in the correction without a cloud of their own (apply_steps).
+std::vector<Vector6d> solve_parts(const VoxelGaussians& target, std::vector<Part>& parts,
+                                  const VgicpSettings& settings, VgicpResult& result) {
+  std::vector<Vector6d> steps;
   double lambda = 1e-4;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
-    result.iterations = iteration + 1;
+    ++result.iterations;
     // The terms are found again at every iteration and held while the steps are tried, so
     // that a step is judged on the same terms as the cost it is compared with.
-    const std::vector<Correspondence> terms = correspond(target, source, T);
-    const VgicpLinearization at = evaluate(source, terms, T, true);
+    std::vector<std::vector<Correspondence>> terms;
+    std::vector<Eigen::Isometry3d> poses;
+    for (const Part& part : parts) {
+      terms.push_back(correspond(target, *part.cloud, part.T));
+      poses.push_back(part.T);
+    }
+    const VgicpLinearization at = evaluate_parts(parts, terms, poses, true);
     if (at.terms < 6) break;  // too few correspondences to fix a pose
     bool accepted = false;
     bool settled = false;
@@ -173,13 +203,14 @@ VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
       damped.diagonal() += lambda * at.hessian.diagonal().cwiseMax(1e-9);
       step = damped.ldlt().solve(-at.gradient);
       if (!step.allFinite()) break;
-      const Eigen::Isometry3d candidate = apply_left(T, step);
-      const VgicpLinearization next = evaluate(source, terms, candidate, false);
+      const std::vector<Eigen::Isometry3d> candidate = stepped(parts, step);
+      const VgicpLinearization next = evaluate_parts(parts, terms, candidate, false);
       if (next.cost <= at.cost) {
         // A step that lowers the cost by a millionth or less: the terms are at their minimum
         // (at fine voxels the points keep trading voxels by fractions of a millimetre).
         settled = at.cost - next.cost <= 1e-6 * at.cost;
-        T = candidate;
+        for (size_t i = 0; i < parts.size(); ++i) parts[i].T = candidate[i];
+        steps.push_back(step);
         lambda = std::max(lambda / 10.0, 1e-9);
         accepted = true;
       } else {
@@ -197,8 +228,23 @@ VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
       break;
     }
   }
-  if (!T.matrix().allFinite()) return VgicpResult{guess, false, result.iterations, 0.0, 0.0, {}};
-  result.T_target_source = T;
+  return steps;
+}
+
+/// The pose that minimises the cost over `target`'s voxels from `guess`: fills the pose,
+/// converged and iterations (the diagnostics that need a second look at the result are
+/// describe()'s).
+VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+  VgicpResult result;
+  result.T_target_source = guess;
+  if (source.size() == 0 || target.size() == 0 || !guess.matrix().allFinite()) return result;
+  std::vector<Part> parts = {{&source, guess, 1.0}};
+  solve_parts(target, parts, settings, result);
+  if (!parts.front().T.matrix().allFinite()) {
+    return VgicpResult{guess, false, result.iterations, 0.0, 0.0, {}};
+  }
+  result.T_target_source = parts.front().T;
   return result;
 }
 
@@ -207,7 +253,8 @@ VgicpResult solve(const VoxelGaussians& target, const GaussianCloud& source,
 void describe(VgicpResult& result, const VoxelGaussians& solved, const VoxelGaussians& measured,
               const GaussianCloud& source, const VgicpSettings& settings) {
   result.hessian = linearize(solved, source, result.T_target_source).hessian;
-  const Fit fit = fit_at(measured, source, result.T_target_source, settings.inlier_distance_m);
+  const VgicpFit fit =
+      measure_fit(measured, source, result.T_target_source, settings.inlier_distance_m);
   result.fitness_m = fit.fitness_m;
   result.inlier_fraction = fit.inlier_fraction;
 }
@@ -223,21 +270,97 @@ VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& s
   return result;
 }
 
-VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
+namespace {
+
+std::vector<VoxelGaussians> levels_of(const GaussianCloud& cloud, const VgicpSettings& settings) {
+  std::vector<VoxelGaussians> levels;
+  levels.reserve(settings.voxel_sizes_m.size());
+  for (const double voxel_m : settings.voxel_sizes_m) levels.emplace_back(cloud, voxel_m);
+  return levels;
+}
+
+}  // namespace
+
+VgicpTarget::VgicpTarget(const GaussianCloud& cloud, const VgicpSettings& settings)
+    : levels(levels_of(cloud, settings)), fitness(cloud, settings.fitness_voxel_m) {}
+
+VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
                   const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
   VgicpResult result;
   result.T_target_source = guess;
-  std::optional<VoxelGaussians> finest;
-  for (const double voxel_m : settings.voxel_sizes_m) {
-    finest.emplace(target, voxel_m);
+  for (const VoxelGaussians& level : target.levels) {
     const int iterations = result.iterations;
-    result = solve(*finest, source, result.T_target_source, settings);
+    result = solve(level, source, result.T_target_source, settings);
     result.iterations += iterations;
   }
-  if (finest && source.size() > 0 && target.size() > 0) {
-    describe(result, *finest, VoxelGaussians(target, settings.fitness_voxel_m), source, settings);
+  if (!target.levels.empty() && source.size() > 0 && target.levels.back().size() > 0) {
+    describe(result, target.levels.back(), target.fitness, source, settings);
   }
   return result;
+}
+
+VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+  return align(VgicpTarget(target, settings), source, guess, settings);
+}
+
+namespace {
+
+/// The fit of several sources at their poses, as one cloud.
+VgicpFit measure_fit(const VoxelGaussians& target, const std::vector<Part>& parts,
+                     double inlier_distance_m) {
+  double squared = 0.0, inliers = 0.0, points = 0.0;
+  for (const Part& part : parts) {
+    const VgicpFit fit = measure_fit(target, *part.cloud, part.T, inlier_distance_m);
+    const double n = fit.inlier_fraction * static_cast<double>(part.cloud->size());
+    squared += fit.fitness_m * fit.fitness_m * n;
+    inliers += n;
+    points += static_cast<double>(part.cloud->size());
+  }
+  VgicpFit fit;
+  if (inliers > 0.0) fit.fitness_m = std::sqrt(squared / inliers);
+  if (points > 0.0) fit.inlier_fraction = inliers / points;
+  return fit;
+}
+
+}  // namespace
+
+SharedVgicpResult align_shared(const VgicpTarget& target, const std::vector<SharedSource>& sources,
+                               const VgicpSettings& settings) {
+  SharedVgicpResult result;
+  std::vector<Part> parts;
+  for (const SharedSource& source : sources) {
+    result.poses.push_back(source.guess);
+    if (source.cloud && source.cloud->size() > 0 && source.guess.matrix().allFinite()) {
+      parts.push_back({source.cloud, source.guess, source.share});
+    }
+  }
+  if (parts.empty() || target.levels.empty() || target.levels.back().size() == 0) return result;
+  result.guess_fit = measure_fit(target.fitness, parts, settings.inlier_distance_m);
+  VgicpResult solved;
+  for (const VoxelGaussians& level : target.levels) {
+    if (level.size() == 0) continue;
+    solved.converged = false;
+    const std::vector<Vector6d> steps = solve_parts(level, parts, settings, solved);
+    result.steps.insert(result.steps.end(), steps.begin(), steps.end());
+  }
+  for (const Part& part : parts) {
+    if (!part.T.matrix().allFinite()) return SharedVgicpResult{result.poses, {}, false, 0, {}, {}};
+  }
+  result.converged = solved.converged;
+  result.iterations = solved.iterations;
+  result.result_fit = measure_fit(target.fitness, parts, settings.inlier_distance_m);
+  for (size_t i = 0; i < sources.size(); ++i) {
+    result.poses[i] = apply_steps(sources[i].guess, result.steps, sources[i].share);
+  }
+  return result;
+}
+
+Eigen::Isometry3d apply_steps(const Eigen::Isometry3d& guess, const std::vector<Vector6d>& steps,
+                              double share) {
+  Eigen::Isometry3d T = guess;
+  for (const Vector6d& step : steps) T = apply_left(T, share * step);
+  return T;
 }
 
 }  // namespace featsense::slam::refine

@@ -59,6 +59,16 @@ struct VgicpLinearization {
 VgicpLinearization linearize(const VoxelGaussians& target, const GaussianCloud& source,
                              const Eigen::Isometry3d& T);
 
+/// How well `source` placed at T fits `target`'s voxels: fitness_m and inlier_fraction as in
+/// VgicpResult. For comparing two poses of one scan on the same voxels (the refinement's
+/// check of its result against the odometry's pose).
+struct VgicpFit {
+  double fitness_m = 0.0;
+  double inlier_fraction = 0.0;
+};
+VgicpFit measure_fit(const VoxelGaussians& target, const GaussianCloud& source,
+                     const Eigen::Isometry3d& T, double inlier_distance_m);
+
 /// Registers `source` to the voxels of `target` from `guess` (target <- source), at their one
 /// voxel size. Never NaN: a failed solve returns the guess with converged = false.
 VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& source,
@@ -68,5 +78,46 @@ VgicpResult align_to_voxels(const VoxelGaussians& target, const GaussianCloud& s
 /// is the finest level's.
 VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
                   const Eigen::Isometry3d& guess, const VgicpSettings& settings = {});
+
+/// A target's voxels at every size of settings.voxel_sizes_m, and at fitness_voxel_m: made
+/// once for a target that many sources are registered to.
+struct VgicpTarget {
+  VgicpTarget(const GaussianCloud& cloud, const VgicpSettings& settings);
+  std::vector<VoxelGaussians> levels;  ///< coarse to fine
+  VoxelGaussians fitness;
+};
+
+/// align() on a target made beforehand (with the same settings).
+VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings = {});
+
+/// One of several sources registered together: the correction found moves each by its share
+/// of it (a drift that grows along a stretch of scans: share 0 at its start, 1 at its end).
+struct SharedSource {
+  const GaussianCloud* cloud = nullptr;
+  Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+  double share = 1.0;
+};
+
+struct SharedVgicpResult {
+  std::vector<Eigen::Isometry3d> poses;  ///< each source's (target <- source)
+  /// The steps of the solve, in the left tangent of the target's frame: apply_steps() gives
+  /// any other pose its share of the correction.
+  std::vector<Vector6d> steps;
+  bool converged = false;
+  int iterations = 0;
+  VgicpFit guess_fit;   ///< all sources at their guesses, on the fitness voxels
+  VgicpFit result_fit;  ///< at the result
+};
+
+/// Registers `sources` to `target` together, coarse to fine: one correction, shared out.
+/// Rotations turn about the target frame's origin: put it near the sources. Never NaN: a
+/// failed solve gives the guesses with converged = false.
+SharedVgicpResult align_shared(const VgicpTarget& target, const std::vector<SharedSource>& sources,
+                               const VgicpSettings& settings = {});
+
+/// `guess` moved by its share of the steps of align_shared.
+Eigen::Isometry3d apply_steps(const Eigen::Isometry3d& guess, const std::vector<Vector6d>& steps,
+                              double share);
 
 }  // namespace featsense::slam::refine
