@@ -239,6 +239,8 @@ std::vector<KeySpec> make_specs() {
       bool_key("refine.enabled", &Config::refine, &RefineConfig::enabled),
       number_key("refine.distance", &Config::refine, &RefineConfig::distance_m,
                  {0.0, 10000.0, true}),
+      number_key("refine.voxel", &Config::refine, &RefineConfig::voxel_m, {0.02, 5.0}),
+      integer_key("refine.max_scans", &Config::refine, &RefineConfig::max_scans, 2, 1000),
   };
 }
 

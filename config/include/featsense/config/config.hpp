@@ -87,7 +87,9 @@ struct OdometryConfig {
 
 struct RefineConfig {
   bool enabled = true;
-  double distance_m = 2.0;
+  double distance_m = 5.0;
+  double voxel_m = 0.5;
+  int max_scans = 64;
 };
 
 struct Config {
