@@ -13,6 +13,8 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
+#include "featsense/slam/refine/placement_refiner.hpp"
+#include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
@@ -31,6 +33,8 @@ struct BenchFrontEndOptions {
   std::string path = "drive";
   std::string trajectory_file;  ///< TUM sensor poses for the simulation instead of --path
   std::string estimate_out;     ///< bench odometry: the estimated poses, TUM
+  bool refine = false;          ///< bench odometry: the map refinement too (refine.*)
+  std::string refined_out;      ///< bench odometry --refine: the refined poses, TUM
   InputOptions input;
   int scans = 100;
   std::optional<std::string> json_path;
@@ -147,11 +151,106 @@ nlohmann::json run_bench_features(const BenchFrontEndOptions& options, const Cli
   return result;
 }
 
+/// The map refinement behind the odometry, as the mapping run does it: each scan deskewed
+/// with the odometry's motion, the stretches registered as they complete.
+class BenchRefinement {
+ public:
+  explicit BenchRefinement(const config::Config& config)
+      : settings_(slam::refine::from_config(config)),
+        refiner_(settings_),
+        deskew_(config.odometry.deskew) {}
+
+  void add(const slam::Scan& scan, const slam::odometry::OdometryResult& odometry) {
+    if (odometry.elapsed_s > 0.0) {
+      motion_ = odometry.T_previous_sensor;
+      period_s_ = odometry.elapsed_s;
+    }
+    slam::ScanPlacement placed;
+    placed.sequence = scan.sequence;
+    placed.stamp_ns = scan.stamp_ns;
+    placed.T_map_sensor = odometry.T_map_sensor;
+    if (deskew_ && period_s_ > 0.0) {
+      placed.column_T_map_sensor = slam::column_poses(scan, placed.T_map_sensor, [&](double t) {
+        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor *
+                                                slam::motion_fraction(motion_, t / period_s_));
+      });
+    }
+    take(refiner_.add(scan, std::move(placed)));
+  }
+
+  /// The poses of the scans still held, refined as a shorter stretch.
+  const slam::Trajectory& finish() {
+    take(refiner_.finish());
+    return refined_;
+  }
+
+  nlohmann::json json() const {
+    const slam::refine::RefineCounts& counts = refiner_.counts();
+    std::vector<double> stretch_ms, step_m, step_deg;
+    double cloud_total_ms = 0.0, stretch_total_ms = 0.0;
+    for (const double ms : refiner_.cloud_ms()) cloud_total_ms += ms;
+    for (const slam::refine::StretchRegistration& r : counts.stretches) {
+      stretch_ms.push_back(r.ms);
+      stretch_total_ms += r.ms;
+      if (r.outcome != slam::refine::RefineOutcome::refined) continue;
+      step_m.push_back(r.step_m);
+      step_deg.push_back(r.step_deg);
+    }
+    return {{"distance_m", settings_.distance_m},
+            {"voxel_m", settings_.voxel_m},
+            {"stretches", counts.stretches.size()},
+            {"scans", counts.scans},
+            {"refined", counts.refined},
+            {"kept_not_converged", counts.not_converged},
+            {"kept_too_far", counts.too_far},
+            {"kept_worse_fit", counts.worse_fit},
+            {"clouds", refiner_.cloud_ms().size()},
+            {"cloud", timing_json(refiner_.cloud_ms())},
+            {"registration", timing_json(stretch_ms)},
+            // What the refinement costs per scan: its clouds and registrations over the scans.
+            {"per_scan_ms", (cloud_total_ms + stretch_total_ms) /
+                                static_cast<double>(std::max<size_t>(counts.scans, 1))},
+            {"step_m", min_median_max(step_m)},
+            {"step_deg", min_median_max(step_deg)}};
+  }
+
+ private:
+  void take(const std::vector<slam::ScanPlacement>& placements) {
+    for (const slam::ScanPlacement& placement : placements)
+      refined_.push_back(placement.stamp_ns, placement.T_map_sensor);
+  }
+
+  slam::refine::RefineSettings settings_;
+  slam::refine::PlacementRefiner refiner_;
+  bool deskew_;
+  Eigen::Isometry3d motion_ = Eigen::Isometry3d::Identity();
+  double period_s_ = 0.0;
+  slam::Trajectory refined_;
+};
+
+/// The trajectory's error against the truth, as JSON (nothing where it is undetermined).
+void add_trajectory_error(const slam::Trajectory& estimate, const slam::Trajectory& truth,
+                          nlohmann::json& out) {
+  if (estimate.size() < 2) return;
+  try {
+    const slam::TrajectoryEvaluation e = slam::evaluate_trajectory(estimate, truth);
+    out["ape_rmse_m"] = e.ape.rmse;
+    out["rpe_translation_rmse_m"] = e.rpe_translation.rmse;
+    out["path_length_m"] = e.ground_truth_length_m;
+    if (e.kitti) out["kitti_translation_drift_percent"] = e.kitti->t_err_pct;
+  } catch (const slam::TrajectoryError& e) {
+    // A straight path leaves the alignment undetermined: no figures, and why.
+    out["trajectory_evaluation_error"] = e.what();
+  }
+}
+
 nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const CliContext& context) {
   const config::Config config = context.load_config({});
   BenchScans scans(options, config);
   const slam::features::FeatureSettings settings = slam::features::from_config(config);
   slam::odometry::FeatureOdometry odometry(slam::odometry::from_config(config));
+  std::optional<BenchRefinement> refinement;
+  if (options.refine) refinement.emplace(config);
 
   std::vector<double> features_ms, registration_ms, total_ms, feature_counts;
   std::vector<double> association_ms, solve_ms, map_update_ms;
@@ -170,6 +269,7 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
     const double features = std::chrono::duration<double, std::milli>(extracted - start).count();
     estimate.stamps_ns.push_back(scan->stamp_ns);
     estimate.poses.push_back(result.T_map_sensor);
+    if (refinement) refinement->add(*scan, result);
     last = result;
     if (result.diagnostics.degenerate) ++degenerate;
     if (i > 0 && !result.diagnostics.converged) ++failed;
@@ -209,17 +309,13 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   result["map_points"] = {{"edges", last.map_edges}, {"surfaces", last.map_surfaces}};
   result["peak_rss_mb"] = peak_rss_mb();
   if (!options.estimate_out.empty()) slam::write_tum(estimate, options.estimate_out);
-  if (scans.truth() && estimate.size() >= 2) {
-    try {
-      const slam::TrajectoryEvaluation e = slam::evaluate_trajectory(estimate, *scans.truth());
-      result["ape_rmse_m"] = e.ape.rmse;
-      result["rpe_translation_rmse_m"] = e.rpe_translation.rmse;
-      result["path_length_m"] = e.ground_truth_length_m;
-      if (e.kitti) result["kitti_translation_drift_percent"] = e.kitti->t_err_pct;
-    } catch (const slam::TrajectoryError& e) {
-      // A straight path leaves the alignment undetermined: no figures, and why.
-      result["trajectory_evaluation_error"] = e.what();
-    }
+  if (scans.truth()) add_trajectory_error(estimate, *scans.truth(), result);
+  if (refinement) {
+    const slam::Trajectory& refined = refinement->finish();
+    if (!options.refined_out.empty()) slam::write_tum(refined, options.refined_out);
+    nlohmann::json refine = refinement->json();
+    if (scans.truth()) add_trajectory_error(refined, *scans.truth(), refine);
+    result["refine"] = refine;
   }
   return result;
 }
@@ -249,6 +345,10 @@ Command add_front_end_bench(CLI::App& bench, const char* name, const char* help,
   if (std::string(name) == "odometry") {
     command->add_option("--trajectory-out", options->estimate_out,
                         "Write the estimated poses here (TUM)");
+    command->add_flag("--refine", options->refine,
+                      "Refine the poses too (refine.*): its ms, and the refined poses' error");
+    command->add_option("--refined-out", options->refined_out,
+                        "With --refine: write the refined poses here (TUM)");
   }
   return {command, [options, run, &context] {
             print_bench_result(run(*options, context), options->json_path);

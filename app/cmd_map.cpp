@@ -14,10 +14,12 @@
 #include "eval_json.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/odometry/odometry_locator.hpp"
+#include "featsense/slam/refine/segment_refiner.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "featsense/tsdf/integrator.hpp"
+#include "front_end_report.hpp"
 #include "json_output.hpp"
 #include "map_job.hpp"
 #include "map_outputs.hpp"
@@ -91,30 +93,10 @@ std::optional<KnownTrajectory> known_trajectory(const MapOptions& options,
   return ground_truth_beside(info);
 }
 
-/// Whether the intensity image confirmed the edges, in words: the fusion is off by the config,
-/// or where the scans had no intensity channel.
-std::string intensity_fusion_text(const slam::odometry::OdometryCounts& counts, bool enabled) {
-  if (!enabled) return "off (odometry.intensity_fusion = false)";
-  if (counts.intensity_confirmed_scans == 0) return "off: the scans have no intensity channel";
-  if (counts.intensity_confirmed_scans < counts.scans) {
-    return "on for " + std::to_string(counts.intensity_confirmed_scans) + " of " +
-           std::to_string(counts.scans) + " scans (the others had no intensity channel)";
-  }
-  return "on";
-}
-
-nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool fusion_enabled) {
-  return {{"scans", counts.scans},
-          {"degenerate_scans", counts.degenerate_scans},
-          {"failed_scans", counts.failed_scans},
-          {"time_jumps", counts.time_jumps},
-          {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
-          {"intensity_fusion", intensity_fusion_text(counts, fusion_enabled)},
-          {"features_per_scan",
-           counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0},
-          {"timings",
-           {{"features", timing_json(counts.features_ms)},
-            {"registration", timing_json(counts.registration_ms)}}}};
+std::string format_metres(double metres) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g m", metres);
+  return text;
 }
 
 tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
@@ -182,8 +164,11 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   pipeline.total_frames = info.frames;
   pipeline.quiet = context.quiet;
   pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
-  spdlog::info("mapping {} ({}; per-point times {}) with {}", info.path, info.format,
-               info.times.empty() ? std::string("unknown") : info.times, locator->description());
+  if (odometry && config.refine.enabled) pipeline.refine = slam::refine::from_config(config);
+  spdlog::info("mapping {} ({}; per-point times {}) with {}{}", info.path, info.format,
+               info.times.empty() ? std::string("unknown") : info.times, locator->description(),
+               pipeline.refine ? ", refined every " + format_metres(pipeline.refine->distance_m)
+                               : std::string());
 
   PipelineResult result;
   MapRunSummary summary;
@@ -223,7 +208,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   summary.input = &info;
   summary.backend = integrator ? integrator->backend_name() : "none";
   summary.backend_reason = backend_reason;
-  summary.poses = locator->description();
+  summary.poses = locator->description() + (pipeline.refine ? ", refined (VGICP)" : "");
   summary.pipeline = &result;
   if (map) summary.map = map->stats();
   summary.continued_chunks = map_store.continued_chunks;
@@ -239,11 +224,18 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                    intensity_fusion_text(counts, true));
     }
   }
+  if (pipeline.refine) report["refine"] = refine_json(result, *pipeline.refine);
   if (truth && result.poses.size() >= 2) {
     try {
       const slam::TrajectoryEvaluationSettings eval_settings;
       report["eval"]["traj"] = trajectory_evaluation_json(
           slam::evaluate_trajectory(result.poses, truth->poses, eval_settings), eval_settings);
+      // The odometry's own poses too, to show what the refinement changed.
+      if (result.unrefined_poses && result.unrefined_poses->size() >= 2) {
+        report["eval"]["traj_unrefined"] = trajectory_evaluation_json(
+            slam::evaluate_trajectory(*result.unrefined_poses, truth->poses, eval_settings),
+            eval_settings);
+      }
     } catch (const slam::TrajectoryError& e) {
       spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
     }

@@ -2,11 +2,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include "bounded_queue.hpp"
@@ -109,6 +112,43 @@ void locate_scans(slam::ScanLocator& locator, bool drop_mixed, BoundedQueue<slam
   }
 }
 
+/// Sends on the placed scans whose poses became final: `held` is in the refiner's order.
+bool send_final(std::vector<slam::ScanPlacement> final, std::deque<PlacedScan>& held,
+                BoundedQueue<PlacedScan>& out) {
+  for (slam::ScanPlacement& placement : final) {
+    if (held.empty() || held.front().placement.sequence != placement.sequence) {
+      throw std::logic_error("refinement: a final pose out of order");
+    }
+    PlacedScan scan = std::move(held.front());
+    held.pop_front();
+    scan.placement = std::move(placement);
+    if (!out.push(std::move(scan))) return false;
+  }
+  return true;
+}
+
+/// The refinement holds each stretch's scans until their poses are final; the queue before
+/// it is deep enough that the odometry does not wait while a stretch is registered.
+void refine_scans(const slam::refine::RefineSettings& settings, BoundedQueue<PlacedScan>& in,
+                  BoundedQueue<PlacedScan>& out, PipelineResult& result) {
+  slam::refine::PlacementRefiner refiner(settings);
+  std::deque<PlacedScan> held;
+  result.unrefined_poses.emplace();
+  while (std::optional<PlacedScan> placed = in.pop()) {
+    const Clock::time_point start = Clock::now();
+    result.unrefined_poses->push_back(placed->placement.stamp_ns, placed->placement.T_map_sensor);
+    std::vector<slam::ScanPlacement> final = refiner.add(placed->scan, placed->placement);
+    held.push_back(std::move(*placed));
+    result.refine_most_held = std::max(result.refine_most_held, held.size());
+    result.timings.refine_ms.push_back(ms_since(start));
+    if (!send_final(std::move(final), held, out)) break;
+  }
+  // The end of the input, or a stop: the last stretch is refined and mapped too.
+  send_final(refiner.finish(), held, out);
+  result.refine = refiner.counts();
+  result.refine_cloud_ms = refiner.cloud_ms();
+}
+
 /// Rays in a stage of their own: with odometry the front end is the pipeline's slowest
 /// stage, and the deskewing of every point need not wait for it.
 void make_rays(BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out,
@@ -190,7 +230,10 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
   PipelineResult result;
   PipelineState state;
   BoundedQueue<slam::Scan> scans(settings.queue_capacity);
-  BoundedQueue<PlacedScan> placed(settings.queue_capacity);
+  // With refinement the odometry runs ahead while a stretch is registered: a deeper queue.
+  BoundedQueue<PlacedScan> placed(settings.refine ? 4 * settings.queue_capacity
+                                                  : settings.queue_capacity);
+  BoundedQueue<PlacedScan> refined(settings.queue_capacity);
   BoundedQueue<LocatedScan> located(settings.queue_capacity);
   const Clock::time_point start = Clock::now();
 
@@ -207,16 +250,27 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
     if (state.stopping()) scans.abandon();
     placed.close();
   });
+  std::thread refinement;
+  if (settings.refine) {
+    refinement = std::thread([&] {
+      guarded(state, [&] { refine_scans(*settings.refine, placed, refined, result); });
+      if (state.stopping()) placed.abandon();
+      refined.close();
+    });
+  }
+  BoundedQueue<PlacedScan>& to_rays = settings.refine ? refined : placed;
   std::thread rays([&] {
-    guarded(state, [&] { make_rays(placed, located, result); });
-    if (state.stopping()) placed.abandon();
+    guarded(state, [&] { make_rays(to_rays, located, result); });
+    if (state.stopping()) to_rays.abandon();
     located.close();
   });
   guarded(state, [&] { MappingStage(open_map, settings, result).run(located); });
   located.abandon();
+  refined.abandon();
   placed.abandon();
   scans.abandon();
   rays.join();
+  if (refinement.joinable()) refinement.join();
   front_end.join();
   reader.join();
 

@@ -1,6 +1,8 @@
 #pragma once
-// The mapping pipeline: a reader thread, a front-end thread (the scan locator) and a mapping
-// thread (shift, TSDF integration, periodic flush of the store), joined by bounded queues.
+// The mapping pipeline: a reader thread, a front-end thread (the scan locator), with odometry a
+// refinement thread (slam/refine: the poses made final a stretch at a time), a thread that
+// turns placed scans into rays and a mapping thread (shift, TSDF integration, periodic flush
+// of the store), joined by bounded queues.
 // A full queue makes the stage before it wait, so memory stays bounded however fast the
 // reader is; a failing stage stops the others and its error is rethrown after all joined.
 
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "featsense/config/config.hpp"
+#include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
@@ -41,6 +44,8 @@ struct PipelineSettings {
   FrameRange range;
   std::optional<size_t> total_frames;  ///< for the progress display, when known
   bool drop_mixed_pixels = true;       ///< sensor.drop_mixed_pixels
+  /// Refine the locator's poses before they are mapped (refine.*; for odometry).
+  std::optional<slam::refine::RefineSettings> refine;
   bool quiet = false;
 };
 
@@ -48,7 +53,8 @@ struct PipelineSettings {
 struct StageTimings {
   std::vector<double> read_ms;
   std::vector<double> locate_ms;
-  std::vector<double> rays_ms;  ///< a placed scan turned into rays (deskewed, in the map frame)
+  std::vector<double> refine_ms;  ///< the refinement stage per scan: its cloud, a registration
+  std::vector<double> rays_ms;    ///< a placed scan turned into rays (deskewed, in the map frame)
   std::vector<double> shift_ms;
   std::vector<double> integrate_ms;
   std::vector<double> flush_ms;
@@ -64,6 +70,11 @@ struct PipelineResult {
   size_t voxels_updated = 0;
   StageTimings timings;
   slam::Trajectory poses;  ///< the pose of every mapped scan, at its stamp
+  /// With refinement: the locator's poses before it, and what it did.
+  std::optional<slam::Trajectory> unrefined_poses;
+  slam::refine::RefineCounts refine;
+  std::vector<double> refine_cloud_ms;  ///< per cloud made
+  size_t refine_most_held = 0;          ///< the most scans waiting for their final pose
   size_t warning_count = 0;
   std::vector<std::string> warnings;  ///< the first few, verbatim
   bool interrupted = false;           ///< stopped by Ctrl+C / SIGTERM

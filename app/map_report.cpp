@@ -33,6 +33,7 @@ nlohmann::json map_report_json(const MapRunSummary& summary) {
   report["voxels_updated"] = run.voxels_updated;
   report["timings"] = {{"read", timing_json(run.timings.read_ms)},
                        {"locate", timing_json(run.timings.locate_ms)},
+                       {"refine", timing_json(run.timings.refine_ms)},
                        {"rays", timing_json(run.timings.rays_ms)},
                        {"shift", timing_json(run.timings.shift_ms)},
                        {"integrate", timing_json(run.timings.integrate_ms)},

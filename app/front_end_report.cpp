@@ -1,0 +1,64 @@
+#include "front_end_report.hpp"
+
+#include <vector>
+
+#include "timing_stats.hpp"
+
+namespace featsense::app {
+
+std::string intensity_fusion_text(const slam::odometry::OdometryCounts& counts, bool enabled) {
+  if (!enabled) return "off (odometry.intensity_fusion = false)";
+  if (counts.intensity_confirmed_scans == 0) return "off: the scans have no intensity channel";
+  if (counts.intensity_confirmed_scans < counts.scans) {
+    return "on for " + std::to_string(counts.intensity_confirmed_scans) + " of " +
+           std::to_string(counts.scans) + " scans (the others had no intensity channel)";
+  }
+  return "on";
+}
+
+nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool fusion_enabled) {
+  return {{"scans", counts.scans},
+          {"degenerate_scans", counts.degenerate_scans},
+          {"failed_scans", counts.failed_scans},
+          {"time_jumps", counts.time_jumps},
+          {"intensity_confirmed_scans", counts.intensity_confirmed_scans},
+          {"intensity_fusion", intensity_fusion_text(counts, fusion_enabled)},
+          {"features_per_scan",
+           counts.scans ? counts.features_sum / static_cast<double>(counts.scans) : 0.0},
+          {"timings",
+           {{"features", timing_json(counts.features_ms)},
+            {"registration", timing_json(counts.registration_ms)}}}};
+}
+
+nlohmann::json refine_json(const PipelineResult& run,
+                           const slam::refine::RefineSettings& settings) {
+  const slam::refine::RefineCounts& counts = run.refine;
+  std::vector<double> registration_ms, step_m, step_deg;
+  for (const slam::refine::StretchRegistration& stretch : counts.stretches) {
+    if (stretch.outcome == slam::refine::RefineOutcome::first) continue;
+    registration_ms.push_back(stretch.ms);
+    if (stretch.outcome != slam::refine::RefineOutcome::refined) continue;
+    step_m.push_back(stretch.step_m);
+    step_deg.push_back(stretch.step_deg);
+  }
+  const TimingSummary steps_m = summarize_ms(step_m);
+  const TimingSummary steps_deg = summarize_ms(step_deg);
+  return {{"distance_m", settings.distance_m},
+          {"voxel_m", settings.voxel_m},
+          {"scans", counts.scans},
+          {"registrations", registration_ms.size()},
+          {"refined", counts.refined},
+          {"kept_odometry",
+           {{"not_converged", counts.not_converged},
+            {"moved_too_far", counts.too_far},
+            {"fits_worse", counts.worse_fit}}},
+          // How far the registrations moved the odometry's guess (its drift over a stretch).
+          {"correction_m", {{"median", steps_m.median_ms}, {"max", steps_m.max_ms}}},
+          {"correction_deg", {{"median", steps_deg.median_ms}, {"max", steps_deg.max_ms}}},
+          {"most_scans_held", run.refine_most_held},
+          {"timings",
+           {{"cloud", timing_json(run.refine_cloud_ms)},
+            {"registration", timing_json(registration_ms)}}}};
+}
+
+}  // namespace featsense::app
