@@ -208,6 +208,14 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
   // A sensor moving through a furnished room at walking speed, range noise on: the path
   // within a few centimetres of the truth after 1.1 s.
   EXPECT_LT(report["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05) << report["eval"].dump(2);
+  // The refinement (on by default) held the scans until their poses were final and mapped
+  // every one of them; the odometry's own poses are compared with the truth too.
+  ASSERT_TRUE(report.contains("refine")) << report.dump(2);
+  EXPECT_EQ(report["refine"]["scans"].get<size_t>(), 12u);
+  EXPECT_GE(report["refine"]["registrations"].get<size_t>(), 1u);
+  EXPECT_GE(report["refine"]["most_scans_held"].get<size_t>(), 2u);
+  EXPECT_TRUE(report["eval"].contains("traj_unrefined")) << report["eval"].dump(2);
+  EXPECT_EQ(report["timings"]["refine"]["count"].get<size_t>(), 12u);
   for (const char* stage : {"features", "registration"}) {
     EXPECT_EQ(report["odometry"]["timings"][stage]["count"].get<size_t>(), 12u) << stage;
     EXPECT_GT(report["odometry"]["timings"][stage]["median_ms"].get<double>(), 0.0) << stage;
