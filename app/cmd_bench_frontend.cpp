@@ -186,6 +186,9 @@ class BenchRefinement {
 
   nlohmann::json json() const {
     const slam::refine::RefineCounts& counts = refiner_.counts();
+    // The first scan is a stretch of its own, with nothing to register.
+    const double stretches = static_cast<double>(std::max<size_t>(
+        counts.refined + counts.not_converged + counts.too_far + counts.worse_fit, 1));
     std::vector<double> stretch_ms, step_m, step_deg;
     double cloud_total_ms = 0.0, stretch_total_ms = 0.0;
     for (const double ms : refiner_.cloud_ms()) cloud_total_ms += ms;
@@ -210,11 +213,21 @@ class BenchRefinement {
             // What the refinement costs per scan: its clouds and registrations over the scans.
             {"per_scan_ms", (cloud_total_ms + stretch_total_ms) /
                                 static_cast<double>(std::max<size_t>(counts.scans, 1))},
+            // A stretch's refinement against the time its scans took to record: above 1 it
+            // keeps up with the sensor.
+            {"per_stretch_ms", (cloud_total_ms + stretch_total_ms) / stretches},
+            {"recorded_per_stretch_ms", recorded_ms() / stretches},
+            {"real_time_factor", recorded_ms() / std::max(cloud_total_ms + stretch_total_ms, 1e-9)},
             {"step_m", min_median_max(step_m)},
             {"step_deg", min_median_max(step_deg)}};
   }
 
  private:
+  double recorded_ms() const {
+    if (refined_.size() < 2) return 0.0;
+    return static_cast<double>(refined_.stamps_ns.back() - refined_.stamps_ns.front()) * 1e-6;
+  }
+
   void take(const std::vector<slam::ScanPlacement>& placements) {
     for (const slam::ScanPlacement& placement : placements)
       refined_.push_back(placement.stamp_ns, placement.T_map_sensor);
