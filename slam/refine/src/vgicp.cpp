@@ -113,10 +113,15 @@ VgicpLinearization evaluate(const GaussianCloud& source, const std::vector<Corre
           const Correspondence& c = terms[k];
           const Eigen::Vector3d x = T * source.points[c.point];
           const Eigen::Vector3d e = c.voxel->mean - x;
-          const Eigen::LLT<Eigen::Matrix3d> llt(c.voxel->covariance +
-                                                R * source.covariances[c.point] * R.transpose());
-          if (llt.info() != Eigen::Success) continue;
-          const Eigen::Matrix3d W = llt.solve(Eigen::Matrix3d::Identity());
+          // The combined covariance is a sum of positive definite ones: its 3x3 inverse in
+          // closed form (cofactors) is exact enough and several times cheaper than a solve.
+          const Eigen::Matrix3d C =
+              c.voxel->covariance + R * source.covariances[c.point] * R.transpose();
+          Eigen::Matrix3d W;
+          double determinant = 0.0;
+          bool invertible = false;
+          C.computeInverseAndDetWithCheck(W, determinant, invertible, 1e-12);
+          if (!invertible || !(determinant > 0.0)) continue;
           sum.cost += e.dot(W * e);
           ++sum.terms;
           if (!derivatives) continue;
