@@ -20,8 +20,8 @@ uint64_t voxel_of(const Eigen::Vector3d& p, double inverse_voxel) {
 
 }  // namespace
 
-GaussianCloud refinement_cloud(const Scan& scan, const ScanPlacement& placement, double voxel_m,
-                               int neighbours) {
+std::vector<Eigen::Vector3f> voxel_centroids(const Scan& scan, const ScanPlacement& placement,
+                                             double voxel_m) {
   if (!(voxel_m > 0.0)) throw std::invalid_argument("refinement_cloud: the voxel must be > 0");
   const Eigen::Isometry3d T_sensor_map = placement.T_map_sensor.inverse();
   const bool deskew = placement.deskewed() &&
@@ -55,7 +55,12 @@ GaussianCloud refinement_cloud(const Scan& scan, const ScanPlacement& placement,
   centroids.reserve(voxels.size());
   for (const auto& [key, sum] : voxels)
     centroids.push_back((sum.point / static_cast<double>(sum.count)).cast<float>());
-  return with_covariances(centroids, neighbours);
+  return centroids;
+}
+
+GaussianCloud refinement_cloud(const Scan& scan, const ScanPlacement& placement, double voxel_m,
+                               int neighbours) {
+  return with_covariances(voxel_centroids(scan, placement, voxel_m), neighbours);
 }
 
 }  // namespace featsense::slam::refine
