@@ -241,6 +241,18 @@ std::vector<KeySpec> make_specs() {
                  {0.0, 10000.0, true}),
       number_key("refine.voxel", &Config::refine, &RefineConfig::voxel_m, {0.02, 5.0}),
       integer_key("refine.max_scans", &Config::refine, &RefineConfig::max_scans, 2, 1000),
+      bool_key("loop.enabled", &Config::loop, &LoopConfig::enabled),
+      number_key("loop.keyframe_distance", &Config::loop, &LoopConfig::keyframe_distance_m,
+                 {0.0, 1000.0, true}),
+      number_key("loop.keyframe_angle_deg", &Config::loop, &LoopConfig::keyframe_angle_deg,
+                 {0.0, 180.0, true}),
+      number_key("loop.min_separation_s", &Config::loop, &LoopConfig::min_separation_s, {0.0, 1e6}),
+      number_key("loop.min_separation", &Config::loop, &LoopConfig::min_separation_m, {0.0, 1e6}),
+      number_key("loop.max_descriptor_distance", &Config::loop,
+                 &LoopConfig::max_descriptor_distance, {0.0, 1.0, true}),
+      number_key("loop.max_fitness", &Config::loop, &LoopConfig::max_fitness_m, {0.0, 10.0, true}),
+      number_key("loop.min_inliers", &Config::loop, &LoopConfig::min_inlier_fraction, {0.0, 1.0}),
+      number_key("loop.drift", &Config::loop, &LoopConfig::drift, {0.0, 1.0}),
   };
 }
 

@@ -92,12 +92,25 @@ struct RefineConfig {
   int max_scans = 64;
 };
 
+struct LoopConfig {
+  bool enabled = true;
+  double keyframe_distance_m = 1.0;
+  double keyframe_angle_deg = 15.0;
+  double min_separation_s = 10.0;
+  double min_separation_m = 20.0;
+  double max_descriptor_distance = 0.35;
+  double max_fitness_m = 0.12;
+  double min_inlier_fraction = 0.55;
+  double drift = 0.02;
+};
+
 struct Config {
   SensorConfig sensor;
   MapConfig map;
   FeaturesConfig features;
   OdometryConfig odometry;
   RefineConfig refine;
+  LoopConfig loop;
   /// The keys given a value explicitly (by the YAML file, a --set or a command-line option
   /// that stands for the key), each with where the value that counts came from: "my.yaml:12",
   /// "--set map.voxel_size=0.05", "--voxel 0.05". A key is here even when the value given
