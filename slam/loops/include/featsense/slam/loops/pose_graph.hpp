@@ -1,0 +1,79 @@
+#pragma once
+/// A pose graph over keyframes, optimised with Ceres: nodes are keyframe poses (map <- sensor),
+/// edges relative poses measured between two of them with their information. Odometry edges
+/// are trusted as measured; loop edges go through a Cauchy loss whose scale shrinks over a few
+/// solves (graduated non-convexity): at first every loop pulls, and a loop that disagrees with
+/// the others and with the odometry ends with a weight near 0 instead of bending the map.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <vector>
+
+namespace featsense::slam::loops {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// A relative pose T_from_to (from <- to) measured between two nodes. Its error is the
+/// perturbation that takes the measured pose to the estimated one, applied on the left:
+/// [Log(R_est R_meas^T); t_est - R_est R_meas^T t_meas], the tangent that voxelized GICP's
+/// Hessian is given in (rotation first, radians, then metres).
+struct PoseGraphEdge {
+  size_t from = 0;
+  size_t to = 0;
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Identity();
+  bool loop = false;  ///< robust (a loop) or trusted (the odometry's chain)
+};
+
+struct PoseGraphSettings {
+  /// The Cauchy scale of loop edges ends at this many standard deviations: a loop whose
+  /// whitened error is beyond a few of them is down-weighted.
+  double final_loss_scale = 3.0;
+  /// Each solve divides the scale by this, from where every loop is within it.
+  double loss_scale_step = 4.0;
+  int max_iterations_per_solve = 50;
+};
+
+struct PoseGraphSummary {
+  int solves = 0;
+  int iterations = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  bool converged = false;
+  /// Per loop edge in the order added: its whitened error at the end and the weight the loss
+  /// gave it (1: obeyed, near 0: rejected by the graph).
+  std::vector<double> loop_chi;
+  std::vector<double> loop_weights;
+};
+
+class PoseGraph {
+ public:
+  /// Adds a node at its first estimate; the first node added is held fixed (the map frame).
+  size_t add_node(const Eigen::Isometry3d& T_map_node);
+  /// Throws std::invalid_argument for a node index out of range, a self edge or an
+  /// information matrix that is not symmetric positive definite.
+  void add_edge(const PoseGraphEdge& edge);
+  PoseGraphSummary optimize(const PoseGraphSettings& settings = {});
+
+  size_t size() const { return poses_.size(); }
+  const Eigen::Isometry3d& pose(size_t node) const { return poses_[node]; }
+  const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }
+  const std::vector<PoseGraphEdge>& edges() const { return edges_; }
+
+  /// The whitened error of an edge at the current poses (sqrt of e^T I e).
+  double whitened_error(const PoseGraphEdge& edge) const;
+
+ private:
+  std::vector<Eigen::Isometry3d> poses_;
+  std::vector<PoseGraphEdge> edges_;
+};
+
+/// The error of an edge measured as T_from_to between poses at `T_map_from` and `T_map_to`, in
+/// the tangent of PoseGraphEdge.
+Eigen::Matrix<double, 6, 1> edge_error(const Eigen::Isometry3d& T_map_from,
+                                       const Eigen::Isometry3d& T_map_to,
+                                       const Eigen::Isometry3d& T_from_to);
+
+}  // namespace featsense::slam::loops

@@ -1,0 +1,178 @@
+#include "featsense/slam/loops/pose_graph.hpp"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace featsense::slam::loops {
+namespace {
+
+/// An edge's whitened error: sqrt(I) times the error of PoseGraphEdge, for Ceres' automatic
+/// derivatives. Poses are a translation and a unit quaternion (Eigen's x y z w order).
+class RelativePoseCost {
+ public:
+  RelativePoseCost(const Eigen::Isometry3d& T_from_to, const Matrix6d& sqrt_information)
+      : q_measured_(T_from_to.rotation()),
+        t_measured_(T_from_to.translation()),
+        sqrt_information_(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* t_from, const T* q_from, const T* t_to, const T* q_to,
+                  T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Vector3> p_from(t_from);
+    const Eigen::Map<const Vector3> p_to(t_to);
+    const Eigen::Map<const Eigen::Quaternion<T>> r_from(q_from);
+    const Eigen::Map<const Eigen::Quaternion<T>> r_to(q_to);
+    const Eigen::Quaternion<T> r_estimated = r_from.conjugate() * r_to;
+    const Vector3 t_estimated = r_from.conjugate() * (p_to - p_from);
+    // R_est R_meas^T, and its angle-axis (the shorter way round).
+    const Eigen::Quaternion<T> r_error = r_estimated * q_measured_.conjugate().template cast<T>();
+    const T wxyz[4] = {r_error.w(), r_error.x(), r_error.y(), r_error.z()};
+    Eigen::Matrix<T, 6, 1> error;
+    ceres::QuaternionToAngleAxis(wxyz, error.data());
+    error.template tail<3>() = t_estimated - r_error * t_measured_.template cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information_.template cast<T>() * error;
+    return true;
+  }
+
+ private:
+  Eigen::Quaterniond q_measured_;
+  Eigen::Vector3d t_measured_;
+  Matrix6d sqrt_information_;
+};
+
+/// U with U^T U = information.
+Matrix6d square_root(const Matrix6d& information) {
+  const Eigen::LLT<Matrix6d> llt(information);
+  if (llt.info() != Eigen::Success)
+    throw std::invalid_argument("pose graph: an edge's information is not positive definite");
+  return llt.matrixU();
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 6, 1> edge_error(const Eigen::Isometry3d& T_map_from,
+                                       const Eigen::Isometry3d& T_map_to,
+                                       const Eigen::Isometry3d& T_from_to) {
+  const Eigen::Isometry3d estimated = T_map_from.inverse() * T_map_to;
+  const Eigen::Matrix3d r_error = estimated.rotation() * T_from_to.rotation().transpose();
+  const Eigen::AngleAxisd angle_axis(r_error);
+  Eigen::Matrix<double, 6, 1> error;
+  error.head<3>() = angle_axis.angle() * angle_axis.axis();
+  error.tail<3>() = estimated.translation() - r_error * T_from_to.translation();
+  return error;
+}
+
+size_t PoseGraph::add_node(const Eigen::Isometry3d& T_map_node) {
+  poses_.push_back(T_map_node);
+  return poses_.size() - 1;
+}
+
+void PoseGraph::add_edge(const PoseGraphEdge& edge) {
+  if (edge.from >= poses_.size() || edge.to >= poses_.size() || edge.from == edge.to) {
+    throw std::invalid_argument("pose graph: an edge between nodes " + std::to_string(edge.from) +
+                                " and " + std::to_string(edge.to) + " of " +
+                                std::to_string(poses_.size()));
+  }
+  if (!edge.information.allFinite() ||
+      !edge.information.isApprox(edge.information.transpose(), 1e-9))
+    throw std::invalid_argument("pose graph: an edge's information is not symmetric");
+  square_root(edge.information);  // throws where it is not positive definite
+  edges_.push_back(edge);
+}
+
+double PoseGraph::whitened_error(const PoseGraphEdge& edge) const {
+  const Eigen::Matrix<double, 6, 1> e =
+      edge_error(poses_[edge.from], poses_[edge.to], edge.T_from_to);
+  return std::sqrt(std::max(0.0, e.dot(edge.information * e)));
+}
+
+PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
+  PoseGraphSummary summary;
+  if (poses_.size() < 2 || edges_.empty()) {
+    summary.converged = true;
+    return summary;
+  }
+  std::vector<Eigen::Vector3d> translations(poses_.size());
+  std::vector<Eigen::Quaterniond> rotations(poses_.size());
+  for (size_t i = 0; i < poses_.size(); ++i) {
+    translations[i] = poses_[i].translation();
+    rotations[i] = Eigen::Quaterniond(poses_[i].rotation()).normalized();
+  }
+  ceres::Problem problem;
+  for (size_t i = 0; i < poses_.size(); ++i) {
+    problem.AddParameterBlock(translations[i].data(), 3);
+    problem.AddParameterBlock(rotations[i].coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+  }
+  problem.SetParameterBlockConstant(translations[0].data());
+  problem.SetParameterBlockConstant(rotations[0].coeffs().data());
+
+  // Every loop within the first scale: the first solve is a plain least-squares one.
+  double scale = settings.final_loss_scale;
+  for (const PoseGraphEdge& edge : edges_) {
+    if (edge.loop) scale = std::max(scale, whitened_error(edge));
+  }
+  std::vector<ceres::LossFunctionWrapper*> loop_losses;
+  for (const PoseGraphEdge& edge : edges_) {
+    ceres::LossFunction* loss = nullptr;
+    if (edge.loop) {
+      loop_losses.push_back(
+          new ceres::LossFunctionWrapper(new ceres::CauchyLoss(scale), ceres::TAKE_OWNERSHIP));
+      loss = loop_losses.back();
+    }
+    auto* cost = new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 3, 4, 3, 4>(
+        new RelativePoseCost(edge.T_from_to, square_root(edge.information)));
+    problem.AddResidualBlock(cost, loss, translations[edge.from].data(),
+                             rotations[edge.from].coeffs().data(), translations[edge.to].data(),
+                             rotations[edge.to].coeffs().data());
+  }
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = settings.max_iterations_per_solve;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  bool first = true;
+  summary.converged = true;
+  while (true) {
+    ceres::Solver::Summary solve;
+    ceres::Solve(options, &problem, &solve);
+    ++summary.solves;
+    summary.iterations += static_cast<int>(solve.iterations.size());
+    if (first) summary.initial_cost = solve.initial_cost;
+    first = false;
+    summary.final_cost = solve.final_cost;
+    if (!solve.IsSolutionUsable()) {
+      summary.converged = false;
+      return summary;  // the poses stay as they were
+    }
+    summary.converged = solve.termination_type == ceres::CONVERGENCE;
+    if (scale <= settings.final_loss_scale) break;
+    scale = std::max(settings.final_loss_scale, scale / std::max(settings.loss_scale_step, 1.5));
+    for (ceres::LossFunctionWrapper* loss : loop_losses)
+      loss->Reset(new ceres::CauchyLoss(scale), ceres::TAKE_OWNERSHIP);
+  }
+  for (size_t i = 0; i < poses_.size(); ++i) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = rotations[i].normalized().toRotationMatrix();
+    pose.translation() = translations[i];
+    poses_[i] = pose;
+  }
+  for (const PoseGraphEdge& edge : edges_) {
+    if (!edge.loop) continue;
+    const double chi = whitened_error(edge);
+    summary.loop_chi.push_back(chi);
+    summary.loop_weights.push_back(1.0 / (1.0 + (chi * chi) / (scale * scale)));
+  }
+  return summary;
+}
+
+}  // namespace featsense::slam::loops

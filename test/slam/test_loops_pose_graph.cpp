@@ -1,0 +1,170 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "common/test_poses.hpp"
+#include "featsense/slam/loops/pose_graph.hpp"
+#include "featsense/slam/loops/trajectory_correction.hpp"
+
+namespace featsense::slam::loops {
+namespace {
+
+using test::pose;
+
+/// Twice round a 20 x 20 m square, a node every metre, and an odometry that drifts: 0.1 deg of
+/// yaw and 1 cm sideways per metre, with a little noise.
+struct DriftingSquare {
+  std::vector<Eigen::Isometry3d> truth;
+  std::vector<Eigen::Isometry3d> odometry;
+
+  DriftingSquare() {
+    for (int lap = 0; lap < 2; ++lap) {
+      for (int side = 0; side < 4; ++side) {
+        for (int step = 0; step < 20; ++step) {
+          const double yaw = side * M_PI / 2.0;
+          const Eigen::Vector2d corner[4] = {{0, 0}, {20, 0}, {20, 20}, {0, 20}};
+          const Eigen::Vector2d at =
+              corner[side] + step * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+          truth.push_back(pose(yaw, 0.0, 0.0, {at.x(), at.y(), 1.0 + 0.1 * lap}));
+        }
+      }
+    }
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    odometry.push_back(truth.front());
+    for (size_t i = 1; i < truth.size(); ++i) {
+      const Eigen::Isometry3d step = truth[i - 1].inverse() * truth[i];
+      const Eigen::Isometry3d drift = pose(0.1 * M_PI / 180.0 + noise(rng), 0.0, 0.0,
+                                           {noise(rng), 0.01 + noise(rng), noise(rng)});
+      odometry.push_back(odometry.back() * step * drift);
+    }
+  }
+
+  double rmse(const std::vector<Eigen::Isometry3d>& poses) const {
+    double sum = 0.0;
+    for (size_t i = 0; i < truth.size(); ++i)
+      sum += (poses[i].translation() - truth[i].translation()).squaredNorm();
+    return std::sqrt(sum / static_cast<double>(truth.size()));
+  }
+};
+
+Matrix6d information(double sigma_rad, double sigma_m) {
+  Matrix6d I = Matrix6d::Zero();
+  I.diagonal().head<3>().setConstant(1.0 / (sigma_rad * sigma_rad));
+  I.diagonal().tail<3>().setConstant(1.0 / (sigma_m * sigma_m));
+  return I;
+}
+
+/// The square's graph: odometry edges, and loops from each node of the second lap to the
+/// same corner of the first, measured from the truth.
+PoseGraph square_graph(const DriftingSquare& square, int loop_every) {
+  PoseGraph graph;
+  for (const Eigen::Isometry3d& T : square.odometry) graph.add_node(T);
+  for (size_t i = 1; i < square.odometry.size(); ++i) {
+    graph.add_edge({i - 1, i, square.odometry[i - 1].inverse() * square.odometry[i],
+                    information(0.01, 0.05), false});
+  }
+  const size_t lap = square.truth.size() / 2;
+  for (size_t i = lap; i < square.truth.size(); i += static_cast<size_t>(loop_every)) {
+    graph.add_edge({i - lap, i, square.truth[i - lap].inverse() * square.truth[i],
+                    information(0.002, 0.02), true});
+  }
+  return graph;
+}
+
+TEST(PoseGraph, RecoversASquarePathFromItsLoops) {
+  const DriftingSquare square;
+  const double before = square.rmse(square.odometry);
+  PoseGraph graph = square_graph(square, 10);
+  const PoseGraphSummary summary = graph.optimize();
+  const double after = square.rmse(graph.poses());
+  EXPECT_GT(before, 1.0);  // the drift is real: metres after 160 m
+  EXPECT_LT(after, 0.1 * before) << "before " << before;
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+  ASSERT_EQ(summary.loop_weights.size(), 8u);
+  for (double w : summary.loop_weights) EXPECT_GT(w, 0.5);
+  // The first node is the map frame: it does not move.
+  EXPECT_LT((graph.pose(0).translation() - square.truth[0].translation()).norm(), 1e-9);
+}
+
+TEST(PoseGraph, AWrongLoopIsOverruledByTheOthers) {
+  const DriftingSquare square;
+  PoseGraph right = square_graph(square, 10);
+  right.optimize();
+  const double without = square.rmse(right.poses());
+  PoseGraph wrong = square_graph(square, 10);
+  // Node 150 said to be where node 30 is: 20 m and half a turn off the truth.
+  wrong.add_edge({30, 150, Eigen::Isometry3d::Identity(), information(0.002, 0.02), true});
+  const PoseGraphSummary summary = wrong.optimize();
+  const double with = square.rmse(wrong.poses());
+  EXPECT_LT(with, 1.1 * without + 0.01) << "without " << without;
+  ASSERT_EQ(summary.loop_weights.size(), 9u);
+  EXPECT_LT(summary.loop_weights.back(), 0.01);
+  for (size_t i = 0; i + 1 < summary.loop_weights.size(); ++i)
+    EXPECT_GT(summary.loop_weights[i], 0.5) << i;
+}
+
+TEST(PoseGraph, EdgeErrorIsTheLeftPerturbation) {
+  const Eigen::Isometry3d measured = pose(0.3, -0.1, 0.2, {1.0, -2.0, 0.5});
+  const Eigen::Isometry3d from = pose(1.0, 0.1, 0.0, {3.0, 4.0, 5.0});
+  // The estimate moved by a small rotation w and translation v on the left of the
+  // measurement.
+  const Eigen::Vector3d w(0.01, -0.02, 0.015);
+  const Eigen::Vector3d v(0.1, 0.05, -0.2);
+  Eigen::Isometry3d perturbed = Eigen::Isometry3d::Identity();
+  perturbed.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+  perturbed.translation() = v;
+  const Eigen::Isometry3d to = from * perturbed * measured;
+  const Eigen::Matrix<double, 6, 1> e = edge_error(from, to, measured);
+  EXPECT_LT((e.head<3>() - w).norm(), 1e-12);
+  EXPECT_LT((e.tail<3>() - v).norm(), 1e-12);
+}
+
+TEST(PoseGraph, RejectsBadEdges) {
+  PoseGraph graph;
+  graph.add_node(Eigen::Isometry3d::Identity());
+  graph.add_node(Eigen::Isometry3d::Identity());
+  EXPECT_THROW(graph.add_edge({0, 2, Eigen::Isometry3d::Identity(), Matrix6d::Identity(), false}),
+               std::invalid_argument);
+  EXPECT_THROW(graph.add_edge({1, 1, Eigen::Isometry3d::Identity(), Matrix6d::Identity(), false}),
+               std::invalid_argument);
+  EXPECT_THROW(graph.add_edge({0, 1, Eigen::Isometry3d::Identity(), -Matrix6d::Identity(), false}),
+               std::invalid_argument);
+  Matrix6d nan = Matrix6d::Identity();
+  nan(2, 3) = NAN;
+  EXPECT_THROW(graph.add_edge({0, 1, Eigen::Isometry3d::Identity(), nan, false}),
+               std::invalid_argument);
+  // A graph without edges optimises to itself.
+  EXPECT_TRUE(graph.optimize().converged);
+}
+
+TEST(TrajectoryCorrection, IsContinuousAndExactAtKeyframes) {
+  TrajectoryCorrection correction;
+  const Eigen::Isometry3d a_before = pose(0.0, 0.0, 0.0, {0, 0, 0});
+  const Eigen::Isometry3d a_after = pose(0.02, 0.0, 0.0, {0.1, 0, 0});
+  const Eigen::Isometry3d b_before = pose(0.5, 0.0, 0.0, {10, 0, 0});
+  const Eigen::Isometry3d b_after = pose(0.45, 0.01, 0.0, {10.3, -0.2, 0.05});
+  correction.add_keyframe(0.0, a_before, a_after);
+  correction.add_keyframe(10.0, b_before, b_after);
+  EXPECT_TRUE(correction.apply(0.0, a_before).isApprox(a_after, 1e-9));
+  EXPECT_TRUE(correction.apply(10.0, b_before).isApprox(b_after, 1e-9));
+  // Before the first and after the last keyframe: their corrections.
+  EXPECT_TRUE(correction.correction_at(-5.0).isApprox(correction.correction_at(0.0), 1e-12));
+  EXPECT_TRUE(correction.correction_at(15.0).isApprox(correction.correction_at(10.0), 1e-12));
+  // No jump anywhere: a millimetre along the path changes the correction by little.
+  for (double s = -1.0; s < 11.0; s += 0.05) {
+    const Eigen::Isometry3d here = correction.correction_at(s);
+    const Eigen::Isometry3d next = correction.correction_at(s + 1e-3);
+    EXPECT_LT((here.translation() - next.translation()).norm(), 1e-4) << s;
+    EXPECT_LT(test::angle_between(here, next), 1e-5) << s;
+  }
+  EXPECT_THROW(correction.add_keyframe(5.0, a_before, a_after), std::invalid_argument);
+  EXPECT_TRUE(TrajectoryCorrection().correction_at(3.0).isApprox(Eigen::Isometry3d::Identity()));
+}
+
+}  // namespace
+}  // namespace featsense::slam::loops
