@@ -96,9 +96,16 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   const KnownTrajectory truth_path{simulation.frame_poses(), true};
   std::optional<slam::Trajectory> given;
   if (options.gt_poses) given = truth_path.poses;
+  // The simulation runs again for the loop closure's second pass (the same scans: it is
+  // deterministic).
+  const SourceReopener reopen = [&]() -> std::unique_ptr<slam::ScanSource> {
+    return std::make_unique<SimulatedScanSource>(
+        simulation, "built-in scene " + options.scene + ", " + options.path + " path",
+        truth.string());
+  };
   const MapOutcome outcome = map_recording(
       source, given, options.gt_poses ? std::nullopt : std::optional<KnownTrajectory>(truth_path),
-      map, config, references, context);
+      map, config, references, context, reopen);
   if (!context.quiet) print_summary(options, outcome);
 }
 

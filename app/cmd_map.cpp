@@ -13,19 +13,19 @@
 #include "commands.hpp"
 #include "eval_json.hpp"
 #include "featsense/config/config_error.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/refine/segment_refiner.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
-#include "featsense/tsdf/integrator.hpp"
 #include "front_end_report.hpp"
 #include "json_output.hpp"
 #include "map_job.hpp"
 #include "map_outputs.hpp"
+#include "map_pass.hpp"
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
-#include "map_store.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
 #include "timing_stats.hpp"
@@ -99,9 +99,21 @@ std::string format_metres(double metres) {
   return text;
 }
 
-tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
-  const Eigen::Vector3d t = pose.translation();
-  return {static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())};
+/// Why the loop closure does not run (empty: it does).
+std::string loop_closure_off_because(bool odometry, const MapOptions& options,
+                                     const config::Config& config) {
+  if (!odometry) return "the poses are given";
+  if (!config.loop.enabled) return "loop.enabled is false";
+  if (options.continue_from) return "--continue keeps the stored map's poses";
+  return "";
+}
+
+/// A pass's speed, for the report of a run that mapped twice.
+nlohmann::json pass_json(const PipelineResult& run) {
+  return {
+      {"scans", run.frames_mapped},
+      {"wall_s", run.wall_s},
+      {"scans_per_s", run.wall_s > 0 ? static_cast<double>(run.frames_mapped) / run.wall_s : 0.0}};
 }
 
 }  // namespace
@@ -109,6 +121,7 @@ tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
 config::Config map_config(const MapOptions& options, const CliContext& context) {
   std::vector<config::Override> overrides;
   add_config_override(overrides, kBackendOption, options.backend);
+  if (options.no_loop_closure) overrides.push_back({"loop.enabled", "false", "--no-loop-closure"});
   return context.load_config(overrides);
 }
 
@@ -119,14 +132,17 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
   if (options.gt) poses = read_poses(options);
   std::unique_ptr<slam::ScanSource> source = options.input.open(config);
   const std::optional<KnownTrajectory> truth = known_trajectory(options, source->info());
+  // A file can be read again: the second pass of the loop closure.
+  const SourceReopener reopen = [&options, config] { return options.input.open(config); };
   return map_recording(*source, std::move(poses), truth, options, config,
-                       find_mesh_references(options.input.input, options.reference), context);
+                       find_mesh_references(options.input.input, options.reference), context,
+                       reopen);
 }
 
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const std::optional<KnownTrajectory>& truth, const MapOptions& options,
                          config::Config config, const MeshReferences& references,
-                         const CliContext& context) {
+                         const CliContext& context, const SourceReopener& reopen) {
   const FrameRange range = frame_range(options);
   const slam::SourceInfo& info = source.info();
   std::unique_ptr<slam::odometry::OdometryLocator> odometry;
@@ -142,79 +158,84 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
 
   const fs::path out(options.output);
   fs::create_directories(out);
-  MapStore map_store = open_map_store(out / "map.h5", config, info.sensor.name,
-                                      options.continue_from, options.overwrite);
-  storage::Hdf5ChunkStore& store = *map_store.store;
-  const tsdf::TsdfSettings settings = tsdf::TsdfSettings::from_config(config.map, info.sensor);
-
-  std::unique_ptr<tsdf::Integrator> integrator;
-  std::unique_ptr<storage::ShiftingMap> map;
-  std::string backend_reason;
-  const MapOpener open_map = [&](const LocatedScan& first) -> storage::ShiftingMap& {
-    integrator = tsdf::make_integrator(config.map.backend, settings,
-                                       position_of(first.placement.T_map_sensor), &backend_reason);
-    spdlog::info("TSDF: {}", backend_reason);
-    map = std::make_unique<storage::ShiftingMap>(*integrator, store, config.map.shift_threshold_m);
-    return *map;
-  };
-
   PipelineSettings pipeline;
   pipeline.flush_interval_s = config.map.flush_interval_s;
   pipeline.range = range;
   pipeline.total_frames = info.frames;
   pipeline.quiet = context.quiet;
   pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
+  pipeline.integrate = !options.poses_only;
   if (odometry && config.refine.enabled) pipeline.refine = slam::refine::from_config(config);
-  spdlog::info("mapping {} ({}; per-point times {}) with {}{}", info.path, info.format,
+  const std::string no_loops = loop_closure_off_because(odometry != nullptr, options, config);
+  if (no_loops.empty()) pipeline.loops = slam::loops::from_config(config);
+  spdlog::info("mapping {} ({}; per-point times {}) with {}{}{}", info.path, info.format,
                info.times.empty() ? std::string("unknown") : info.times, locator->description(),
                pipeline.refine ? ", refined every " + format_metres(pipeline.refine->distance_m)
-                               : std::string());
+                               : std::string(),
+               pipeline.loops ? ", loops closed" : std::string());
+  if (odometry && !no_loops.empty()) spdlog::info("loop closure off: {}", no_loops);
 
-  PipelineResult result;
-  MapRunSummary summary;
-  {
-    const StopSignal stop_signal;
-    try {
-      result = run_map_pipeline(source, *locator, open_map, pipeline);
-    } catch (...) {
-      // Whatever was integrated goes to disk before the error is reported.
-      try {
-        if (map) map->sync();
-        store.close();
-      } catch (const std::exception& e) {
-        spdlog::error("could not write the map after the failure: {}", e.what());
+  MapPassOutput pass =
+      run_map_pass(source, *locator, pipeline, config,
+                   {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite});
+  const PipelineResult first = pass.result;  // the odometry's poses, before the loops
+  const std::optional<LoopOutcome>& loops = first.loops;
+  std::string second_pass = "no loop closed";
+  std::optional<PipelineResult> second;
+  if (loops && !loops->loops.empty()) {
+    if (first.interrupted) {
+      second_pass = "interrupted: the map keeps the odometry's poses";
+    } else if (options.poses_only) {
+      second_pass = "--poses-only: no map";
+    } else if (!reopen) {
+      second_pass = "the input cannot be read twice: the map keeps the odometry's poses";
+    } else {
+      // The recording again, with the corrected poses, into a new file that replaces the
+      // first map only once it is complete.
+      spdlog::info("{} loops closed: mapping the recording again with the corrected poses",
+                   loops->loops.size());
+      const std::unique_ptr<slam::ScanSource> again = reopen();
+      const std::unique_ptr<slam::ScanLocator> corrected =
+          slam::make_given_pose_locator(loops->corrected, config.odometry.deskew);
+      PipelineSettings replay = pipeline;
+      replay.refine.reset();
+      replay.loops.reset();
+      const fs::path replay_path = out / "map.corrected.h5";
+      MapPassOutput replayed = run_map_pass(*again, *corrected, replay, config,
+                                            {replay_path, info.sensor.name, std::nullopt, true});
+      if (replayed.result.interrupted) {
+        fs::remove(replay_path);
+        second_pass = "interrupted: the map keeps the odometry's poses";
+        pass.result.interrupted = true;
+      } else {
+        fs::rename(replay_path, out / "map.h5");
+        second_pass = "mapped again with the corrected poses";
+        pass = std::move(replayed);
+        second = pass.result;
       }
-      throw;
     }
-    if (map) {
-      const auto start = std::chrono::steady_clock::now();
-      map->sync();
-      summary.final_flush_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-              .count());
-    }
-    slam::Trajectory all_poses = map_store.earlier_poses;
-    for (size_t i = 0; i < result.poses.size(); ++i) {
-      all_poses.push_back(result.poses.stamps_ns[i], result.poses.poses[i]);
-    }
-    store.write_trajectory(to_store_poses(all_poses));
-    summary.map_chunks = store.keys().size();
-    store.close();
   }
-  slam::write_tum(result.poses, (out / "trajectory.tum").string());
-  slam::write_kitti(result.poses, (out / "trajectory.kitti").string());
+  const PipelineResult& result = pass.result;
+  // The poses the map was made with; with loops closed and no second pass, the corrected ones
+  // all the same (to map later with --gt).
+  const slam::Trajectory& final_poses =
+      loops && !loops->loops.empty() && !second ? loops->corrected : result.poses;
+  slam::write_tum(final_poses, (out / "trajectory.tum").string());
+  slam::write_kitti(final_poses, (out / "trajectory.kitti").string());
 
+  MapRunSummary summary;
   summary.config = &config;
   summary.input = &info;
-  summary.backend = integrator ? integrator->backend_name() : "none";
-  summary.backend_reason = backend_reason;
-  summary.poses = locator->description() + (pipeline.refine ? ", refined (VGICP)" : "");
+  summary.backend = pass.backend;
+  summary.backend_reason = pass.backend_reason;
+  summary.poses = locator->description() + (pipeline.refine ? ", refined (VGICP)" : "") +
+                  (second ? ", loops closed" : "");
   summary.pipeline = &result;
-  if (map) summary.map = map->stats();
-  summary.continued_chunks = map_store.continued_chunks;
-  if (integrator && integrator->backend_name() == "cuda") {
-    summary.device_memory_bytes = integrator->memory_bytes();
-  }
+  summary.map = pass.map;
+  summary.map_chunks = pass.map_chunks;
+  summary.continued_chunks = pass.continued_chunks;
+  summary.device_memory_bytes = pass.device_memory_bytes;
+  summary.final_flush_ms = pass.final_flush_ms;
   nlohmann::json report = map_report_json(summary);
   if (odometry) {
     const slam::odometry::OdometryCounts counts = odometry->counts();
@@ -224,23 +245,33 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                    intensity_fusion_text(counts, true));
     }
   }
-  if (pipeline.refine) report["refine"] = refine_json(result, *pipeline.refine);
-  if (truth && result.poses.size() >= 2) {
+  if (pipeline.refine) report["refine"] = refine_json(first, *pipeline.refine);
+  if (loops) {
+    report["loops"] = loops_json(*loops, first.timings.loops_finish_ms);
+    report["loops"]["second_pass"] = second_pass;
+    report["loops"]["first_pass"] = pass_json(first);
+    if (second) report["loops"]["second_pass_run"] = pass_json(*second);
+  } else if (odometry) {
+    report["loops"] = {{"enabled", false}, {"why", no_loops}};
+  }
+  if (truth && final_poses.size() >= 2) {
     try {
       const slam::TrajectoryEvaluationSettings eval_settings;
-      report["eval"]["traj"] = trajectory_evaluation_json(
-          slam::evaluate_trajectory(result.poses, truth->poses, eval_settings), eval_settings);
-      // The odometry's own poses too, to show what the refinement changed.
-      if (result.unrefined_poses && result.unrefined_poses->size() >= 2) {
-        report["eval"]["traj_unrefined"] = trajectory_evaluation_json(
-            slam::evaluate_trajectory(*result.unrefined_poses, truth->poses, eval_settings),
-            eval_settings);
-      }
+      const auto evaluate = [&](const slam::Trajectory& trajectory) {
+        return trajectory_evaluation_json(
+            slam::evaluate_trajectory(trajectory, truth->poses, eval_settings), eval_settings);
+      };
+      report["eval"]["traj"] = evaluate(final_poses);
+      // The front end's own poses too, to show what the loops and the refinement changed.
+      if (loops && !loops->loops.empty())
+        report["eval"]["traj_before_loops"] = evaluate(first.poses);
+      if (first.unrefined_poses && first.unrefined_poses->size() >= 2)
+        report["eval"]["traj_unrefined"] = evaluate(*first.unrefined_poses);
     } catch (const slam::TrajectoryError& e) {
       spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
     }
   }
-  if (!options.no_mesh && result.frames_mapped > 0) {
+  if (!options.no_mesh && !options.poses_only && result.frames_mapped > 0) {
     const MapMesh meshed = mesh_map(out / "map.h5", out);
     report["mesh"] = mesh_json(meshed);
     if (std::optional<nlohmann::json> evaluation = evaluate_map_mesh(meshed.mesh, references)) {
@@ -292,6 +323,11 @@ Command register_map(CLI::App& app, const CliContext& context) {
   command->add_option("--end", options->end, "Last scan to map (as --start)");
   command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
   command->add_flag("--no-mesh", options->no_mesh, "Write the map only, no mesh.ply / mesh.glb");
+  command->add_flag("--no-loop-closure", options->no_loop_closure,
+                    "Map with the odometry's poses alone (loop.enabled false)");
+  command->add_flag("--poses-only", options->poses_only,
+                    "Estimate the poses (odometry, refinement, loops) and write trajectory.tum "
+                    "and the report only, no map: map later with --gt trajectory.tum");
   command
       ->add_option("--reference-trajectory", options->reference_trajectory,
                    "The true path (TUM or KITTI), to compare the poses with in report.json "

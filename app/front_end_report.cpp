@@ -61,4 +61,40 @@ nlohmann::json refine_json(const PipelineResult& run,
             {"registration", timing_json(registration_ms)}}}};
 }
 
+nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms) {
+  const slam::loops::LoopCounts& counts = outcome.counts;
+  nlohmann::json rejected = nlohmann::json::object();
+  for (const auto& [reason, count] : counts.rejected) rejected[reason] = count;
+  nlohmann::json list = nlohmann::json::array();
+  const int64_t origin_ns = outcome.before.empty() ? 0 : outcome.before.stamps_ns.front();
+  for (const slam::loops::LoopRecord& loop : outcome.loops) {
+    list.push_back(
+        {{"keyframe", loop.query},
+         {"revisits_keyframe", loop.candidate},
+         {"time_s", static_cast<double>(loop.query_stamp_ns - origin_ns) * 1e-9},
+         {"revisits_time_s", static_cast<double>(loop.candidate_stamp_ns - origin_ns) * 1e-9},
+         {"found_by", loop.found_by},
+         {"descriptor_distance", loop.descriptor_distance},
+         {"fitness_m", loop.fitness_m},
+         {"inlier_fraction", loop.inlier_fraction},
+         {"correction_m", loop.correction_m},
+         {"correction_deg", loop.correction_deg},
+         {"weight", loop.weight}});
+  }
+  return {{"keyframes", counts.keyframes},
+          {"candidates", counts.candidates},
+          {"verified", counts.verified},
+          {"accepted", outcome.loops.size()},
+          {"rejected", rejected},
+          {"optimisations", counts.optimisations},
+          {"max_scan_correction_m", outcome.corrections_max_m},
+          {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
+          {"loops", list},
+          {"timings",
+           {{"keyframe", timing_json(counts.keyframe_ms)},
+            {"optimise", timing_json(counts.optimise_ms)},
+            {"pipeline_wait_ms", outcome.keyframe_queue_wait_ms},
+            {"after_last_scan_ms", finish_ms}}}};
+}
+
 }  // namespace featsense::app

@@ -1,6 +1,6 @@
 #pragma once
-// The front end's sections of report.json: what the odometry did (`odometry`) and what the
-// refinement did (`refine`).
+// The front end's sections of report.json: what the odometry did (`odometry`), what the
+// refinement did (`refine`) and the loops closed (`loops`).
 
 #include <nlohmann/json.hpp>
 
@@ -20,5 +20,10 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool 
 /// The refinement of a run that refined (run.unrefined_poses set): stretches, what was kept
 /// and why, the corrections, the latency in scans and the times.
 nlohmann::json refine_json(const PipelineResult& run, const slam::refine::RefineSettings& settings);
+
+/// The loop closure of a run: keyframes, candidates, what was rejected and why, each loop
+/// accepted (the keyframes, their stamps, the fit, the correction it brought, its final
+/// weight), the largest correction of a scan and the times.
+nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms);
 
 }  // namespace featsense::app

@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -29,7 +31,9 @@ struct MapOptions {
   std::optional<std::string> reference_trajectory;  ///< the true path, for eval.traj
   bool overwrite = false;
   bool no_mesh = false;
-  bool print_summary = true;  ///< the one-line summary on stdout
+  bool no_loop_closure = false;  ///< loop.enabled false
+  bool poses_only = false;       ///< the poses and the report, no map
+  bool print_summary = true;     ///< the one-line summary on stdout
 };
 
 struct MapOutcome {
@@ -53,6 +57,10 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context);
 /// ConfigError.
 config::Config map_config(const MapOptions& options, const CliContext& context);
 
+/// Opens the recording again from its start, for the loop closure's second pass; empty where
+/// the input cannot be read twice.
+using SourceReopener = std::function<std::unique_ptr<slam::ScanSource>()>;
+
 /// Maps `source` with `poses` (given poses; nullopt: estimated by the odometry front end) and
 /// `config` (from map_config) into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb,
 /// report.json), comparing the path with `truth` where given. Throws ConfigError,
@@ -60,6 +68,6 @@ config::Config map_config(const MapOptions& options, const CliContext& context);
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const std::optional<KnownTrajectory>& truth, const MapOptions& options,
                          config::Config config, const MeshReferences& references,
-                         const CliContext& context);
+                         const CliContext& context, const SourceReopener& reopen = {});
 
 }  // namespace featsense::app

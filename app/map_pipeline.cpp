@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -150,13 +151,15 @@ void refine_scans(const slam::refine::RefineSettings& settings, BoundedQueue<Pla
 }
 
 /// Rays in a stage of their own: with odometry the front end is the pipeline's slowest
-/// stage, and the deskewing of every point need not wait for it.
-void make_rays(BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out,
-               PipelineResult& result) {
+/// stage, and the deskewing of every point need not wait for it. The poses are final here:
+/// the loop closure sees each scan too. Without integration there are no rays to make.
+void make_rays(BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out, LoopStage* loops,
+               bool integrate, PipelineResult& result) {
   while (std::optional<PlacedScan> placed = in.pop()) {
     const Clock::time_point start = Clock::now();
+    if (loops && !loops->offer(placed->scan, placed->placement)) break;
     LocatedScan located;
-    located.rays = scan_to_rays(placed->scan, placed->placement);
+    if (integrate) located.rays = scan_to_rays(placed->scan, placed->placement);
     located.placement = std::move(placed->placement);
     result.timings.rays_ms.push_back(ms_since(start));
     if (!out.push(std::move(located))) break;
@@ -172,6 +175,12 @@ class MappingStage {
     Progress progress("frames", settings_.total_frames, settings_.quiet);
     Clock::time_point last_flush = Clock::now();
     while (std::optional<LocatedScan> scan = in.pop()) {
+      if (!settings_.integrate) {
+        result_.poses.push_back(scan->placement.stamp_ns, scan->placement.T_map_sensor);
+        ++result_.frames_mapped;
+        progress.update(result_.frames_read, std::to_string(result_.frames_mapped) + " placed");
+        continue;
+      }
       if (!map_) map_ = &open_map_(*scan);
       const Eigen::Vector3d at = scan->placement.T_map_sensor.translation();
       Clock::time_point start = Clock::now();
@@ -259,8 +268,10 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
     });
   }
   BoundedQueue<PlacedScan>& to_rays = settings.refine ? refined : placed;
+  std::unique_ptr<LoopStage> loops;
+  if (settings.loops) loops = std::make_unique<LoopStage>(*settings.loops);
   std::thread rays([&] {
-    guarded(state, [&] { make_rays(to_rays, located, result); });
+    guarded(state, [&] { make_rays(to_rays, located, loops.get(), settings.integrate, result); });
     if (state.stopping()) to_rays.abandon();
     located.close();
   });
@@ -273,6 +284,15 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
   if (refinement.joinable()) refinement.join();
   front_end.join();
   reader.join();
+  if (loops) {
+    // On a stop too: the keyframes queued are few, and the corrected path is worth having.
+    if (state.stopping() && !StopSignal::requested()) loops->abandon();
+    guarded(state, [&] {
+      const Clock::time_point loops_start = Clock::now();
+      result.loops = loops->finish();
+      result.timings.loops_finish_ms = ms_since(loops_start);
+    });
+  }
 
   result.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   result.interrupted = StopSignal::requested();

@@ -1,8 +1,9 @@
 #pragma once
 // The mapping pipeline: a reader thread, a front-end thread (the scan locator), with odometry a
 // refinement thread (slam/refine: the poses made final a stretch at a time), a thread that
-// turns placed scans into rays and a mapping thread (shift, TSDF integration, periodic flush
-// of the store), joined by bounded queues.
+// turns placed scans into rays (and hands keyframes to the loop closure's thread) and a
+// mapping thread (shift, TSDF integration, periodic flush of the store), joined by bounded
+// queues.
 // A full queue makes the stage before it wait, so memory stays bounded however fast the
 // reader is; a failing stage stops the others and its error is rethrown after all joined.
 
@@ -13,12 +14,14 @@
 #include <vector>
 
 #include "featsense/config/config.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/shifting_map.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
+#include "loop_stage.hpp"
 
 namespace featsense::app {
 
@@ -46,6 +49,12 @@ struct PipelineSettings {
   bool drop_mixed_pixels = true;       ///< sensor.drop_mixed_pixels
   /// Refine the locator's poses before they are mapped (refine.*; for odometry).
   std::optional<slam::refine::RefineSettings> refine;
+  /// Close loops over the final poses (loop.*; for odometry): keyframes, verification, the
+  /// pose graph in a thread of their own; the corrected poses come with the result.
+  std::optional<slam::loops::LoopSettings> loops;
+  /// False: the poses only, nothing integrated (`map --poses-only`); the map opener is not
+  /// called.
+  bool integrate = true;
   bool quiet = false;
 };
 
@@ -58,6 +67,7 @@ struct StageTimings {
   std::vector<double> shift_ms;
   std::vector<double> integrate_ms;
   std::vector<double> flush_ms;
+  double loops_finish_ms = 0.0;  ///< after the last scan: the keyframes left, the last solve
 };
 
 struct PipelineResult {
@@ -75,6 +85,7 @@ struct PipelineResult {
   slam::refine::RefineCounts refine;
   std::vector<double> refine_cloud_ms;  ///< per cloud made
   size_t refine_most_held = 0;          ///< the most scans waiting for their final pose
+  std::optional<LoopOutcome> loops;     ///< with loop closure
   size_t warning_count = 0;
   std::vector<std::string> warnings;  ///< the first few, verbatim
   bool interrupted = false;           ///< stopped by Ctrl+C / SIGTERM

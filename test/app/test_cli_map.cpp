@@ -233,6 +233,53 @@ TEST_F(CliMap, WithoutGivenPosesTheOdometryEstimatesThem) {
   EXPECT_LT(second["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);
 }
 
+TEST_F(CliMap, ClosedLoopsMapTheRecordingAgainWithTheCorrectedPoses) {
+  // The walk is 3 m long: with keyframes every 0.3 m and revisits allowed 1 m back, the
+  // keyframes close loops with those before them, as a longer run does with a real revisit.
+  const std::string loops =
+      " --set loop.keyframe_distance=0.3 --set loop.min_separation=1 "
+      "--set loop.min_separation_s=0.5";
+  const fs::path dir = scratch_dir("cli_map_loops");
+  const CommandResult run = run_featsense("map " + sequence() + " -o " + (dir / "out").string() +
+                                          kSmallMap + loops + " --no-mesh");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json report = read_json(dir / "out" / "report.json");
+  ASSERT_TRUE(report.contains("loops")) << report.dump(2);
+  const nlohmann::json& closed = report["loops"];
+  EXPECT_GE(closed["keyframes"].get<size_t>(), 8u) << closed.dump(2);
+  ASSERT_GE(closed["accepted"].get<size_t>(), 1u) << closed.dump(2);
+  EXPECT_EQ(closed["loops"].size(), closed["accepted"].get<size_t>());
+  EXPECT_EQ(closed["second_pass"], "mapped again with the corrected poses");
+  EXPECT_EQ(closed["second_pass_run"]["scans"].get<size_t>(), 24u);
+  EXPECT_LE(closed["loops"][0]["fitness_m"].get<double>(), 0.12);
+  // The map of the second pass replaced the first; the poses are the corrected ones.
+  EXPECT_TRUE(fs::exists(dir / "out" / "map.h5"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "map.corrected.h5"));
+  EXPECT_EQ(count_lines(dir / "out" / "trajectory.tum"), 24u);
+  EXPECT_EQ(storage::Hdf5ChunkStore(dir / "out" / "map.h5").read_trajectory().size(), 24u);
+  ASSERT_TRUE(report["eval"].contains("traj_before_loops")) << report["eval"].dump(2);
+  EXPECT_LT(report["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);
+
+  // The poses alone: no map, the same report sections.
+  const CommandResult poses =
+      run_featsense("map " + sequence() + " -o " + (dir / "poses").string() + kSmallMap + loops +
+                    " --poses-only");
+  ASSERT_EQ(poses.exit_code, 0) << poses.output;
+  EXPECT_FALSE(fs::exists(dir / "poses" / "map.h5"));
+  EXPECT_FALSE(fs::exists(dir / "poses" / "mesh.ply"));
+  EXPECT_EQ(count_lines(dir / "poses" / "trajectory.tum"), 24u);
+  const nlohmann::json poses_report = read_json(dir / "poses" / "report.json");
+  EXPECT_EQ(poses_report["loops"]["second_pass"], "--poses-only: no map");
+
+  // Switched off: the report says why.
+  const CommandResult off = run_featsense("map " + sequence() + " -o " + (dir / "off").string() +
+                                          " --end 5 --no-mesh --no-loop-closure" + kSmallMap);
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  const nlohmann::json off_report = read_json(dir / "off" / "report.json");
+  EXPECT_EQ(off_report["loops"]["enabled"], false);
+  EXPECT_EQ(off_report["loops"]["why"], "loop.enabled is false");
+}
+
 TEST_F(CliMap, BadInputGivesOneClearError) {
   const fs::path dir = scratch_dir("cli_map_errors");
   const std::string out = " -o " + (dir / "out").string();

@@ -1,0 +1,78 @@
+#include "loop_stage.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "featsense/slam/refine/refinement_cloud.hpp"
+
+namespace featsense::app {
+namespace {
+
+/// Keyframes waiting for the loop thread: enough to ride out one verification that takes
+/// long, few enough that the map is not held up for long.
+constexpr size_t kKeyframesQueued = 8;
+
+}  // namespace
+
+LoopStage::LoopStage(const slam::loops::LoopSettings& settings)
+    : settings_(settings),
+      selector_(settings.keyframe_distance_m, settings.keyframe_angle_deg),
+      closer_(settings),
+      queue_(kKeyframesQueued),
+      worker_([this] { work(); }) {}
+
+LoopStage::~LoopStage() {
+  abandon();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LoopStage::work() {
+  try {
+    while (std::optional<KeyframeJob> job = queue_.pop())
+      closer_.add_keyframe(job->stamp_ns, job->travelled_m, job->T_map_sensor, job->points);
+  } catch (...) {
+    failure_ = std::current_exception();
+    queue_.abandon();
+  }
+}
+
+bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placement) {
+  const bool keyframe = selector_.next(placement.T_map_sensor);
+  path_.push_back(placement.stamp_ns, placement.T_map_sensor);
+  travelled_m_.push_back(selector_.travelled_m());
+  if (!keyframe) return true;
+  KeyframeJob job;
+  job.stamp_ns = placement.stamp_ns;
+  job.travelled_m = selector_.travelled_m();
+  job.T_map_sensor = placement.T_map_sensor;
+  job.points = slam::refine::voxel_centroids(scan, placement, settings_.cloud_voxel_m);
+  const auto start = std::chrono::steady_clock::now();
+  const bool queued = queue_.push(std::move(job));
+  wait_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return queued;
+}
+
+void LoopStage::abandon() { queue_.abandon(); }
+
+LoopOutcome LoopStage::finish() {
+  queue_.close();
+  if (worker_.joinable()) worker_.join();
+  if (failure_) std::rethrow_exception(failure_);
+  LoopOutcome out;
+  if (!closer_.loops().empty()) out.final_optimisation = closer_.optimise();
+  out.loops = closer_.loops();
+  out.counts = closer_.counts();
+  out.keyframe_queue_wait_ms = wait_ms_;
+  out.before = path_;
+  const slam::loops::TrajectoryCorrection correction = closer_.correction();
+  for (size_t i = 0; i < path_.size(); ++i) {
+    const Eigen::Isometry3d corrected = correction.apply(travelled_m_[i], path_.poses[i]);
+    out.corrections_max_m = std::max(
+        out.corrections_max_m, (corrected.translation() - path_.poses[i].translation()).norm());
+    out.corrected.push_back(path_.stamps_ns[i], corrected);
+  }
+  return out;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,67 @@
+#pragma once
+// Loop closure as a stage of the mapping pipeline: every scan whose pose is final passes
+// through offer() (from the rays thread); a keyframe's points go to a thread of its own, where
+// the loop closer searches, verifies and optimises, so that the pipeline does not wait for it
+// unless it falls a few keyframes behind. At the end the corrections of the keyframes are
+// spread over every scan's pose.
+
+#include <exception>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "bounded_queue.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/scan.hpp"
+#include "featsense/slam/scan_locator.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+
+namespace featsense::app {
+
+struct LoopOutcome {
+  std::vector<slam::loops::LoopRecord> loops;
+  slam::loops::LoopCounts counts;
+  slam::loops::PoseGraphSummary final_optimisation;
+  /// Every scan offered: the pose it came with, and corrected by the keyframes around it.
+  slam::Trajectory before;
+  slam::Trajectory corrected;
+  double corrections_max_m = 0.0;       ///< the largest move of a scan's position
+  double keyframe_queue_wait_ms = 0.0;  ///< the pipeline's wait for the loop thread, in all
+};
+
+class LoopStage {
+ public:
+  explicit LoopStage(const slam::loops::LoopSettings& settings);
+  ~LoopStage();
+  LoopStage(const LoopStage&) = delete;
+  LoopStage& operator=(const LoopStage&) = delete;
+
+  /// The next scan whose pose is final, in order. False once the stage was abandoned.
+  bool offer(const slam::Scan& scan, const slam::ScanPlacement& placement);
+  /// No more scans: the loop thread finishes the keyframes queued, the graph is optimised
+  /// once more and every pose corrected. Rethrows the loop thread's failure.
+  LoopOutcome finish();
+  /// Stops the loop thread without waiting for what is queued (a failing pipeline).
+  void abandon();
+
+ private:
+  struct KeyframeJob {
+    int64_t stamp_ns = 0;
+    double travelled_m = 0.0;
+    Eigen::Isometry3d T_map_sensor;
+    std::vector<Eigen::Vector3f> points;
+  };
+  void work();
+
+  slam::loops::LoopSettings settings_;
+  slam::loops::KeyframeSelector selector_;
+  slam::loops::LoopCloser closer_;
+  BoundedQueue<KeyframeJob> queue_;
+  std::exception_ptr failure_;
+  slam::Trajectory path_;
+  std::vector<double> travelled_m_;
+  double wait_ms_ = 0.0;
+  std::thread worker_;  ///< last: it starts once everything it uses is there
+};
+
+}  // namespace featsense::app
