@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "featsense/slam/sim/scene_library.hpp"
 #include "map_job.hpp"
 #include "simulate_job.hpp"
 #include "simulated_scan_source.hpp"
@@ -116,11 +117,15 @@ Command register_demo(CLI::App& app, const CliContext& context) {
   CLI::App* command = app.add_subcommand(
       "demo", "Simulate a built-in scene, map it, mesh it and compare it with the truth");
   command->add_option("-o,--output", options->output, "Output folder")->capture_default_str();
-  command->add_option("--scene", options->scene, "Built-in scene: lab, parking or corridor")
-      ->check(CLI::IsMember({"lab", "parking", "corridor"}))
+  command->add_option("--scene", options->scene, "Built-in scene: lab, parking, corridor or town")
+      ->check(CLI::IsMember(slam::scene_names()))
       ->capture_default_str();
-  command->add_option("--path", options->path, "The sensor's path: walk, drive or drone")
-      ->check(CLI::IsMember({"walk", "drive", "drone"}))
+  // Which paths a scene has is the scene library's to say (an unknown one is an error that
+  // lists them).
+  command
+      ->add_option("--path", options->path,
+                   "The sensor's path: walk, drive, drone (lab, corridor, parking), loop "
+                   "(parking, town)")
       ->capture_default_str();
   command->add_option("--frames", options->frames, "Frames to simulate (default: the whole path)")
       ->check(CLI::Range(1, 100000));

@@ -177,13 +177,15 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
       "simulate", "Simulate a spinning LiDAR in a built-in scene or a mesh, with ground truth");
   command
       ->add_option("--scene", o->scene,
-                   "Built-in scene (lab, parking, corridor) or a mesh file (PLY, OBJ, glTF/GLB, "
-                   "DAE, STL)")
+                   "Built-in scene (lab, parking, corridor, town) or a mesh file (PLY, OBJ, "
+                   "glTF/GLB, DAE, STL)")
       ->required();
   command->add_option("-o,--output", o->output_dir, "Folder for the recording")->required();
   command->add_option("--sensor", o->sensor, "Sensor preset, or an Ouster metadata .json")
       ->capture_default_str();
-  command->add_option("--path", o->path, "Named path of a built-in scene: walk, drive, drone");
+  command->add_option("--path", o->path,
+                      "Named path of a built-in scene: walk, drive, drone (lab, corridor, "
+                      "parking), loop (parking, town); default walk");
   command->add_option("--trajectory", o->trajectory_file,
                       "TUM file of sensor poses (map <- sensor)");
   command->add_option("--frames", o->frames, "Frames to simulate (default: the whole path)")

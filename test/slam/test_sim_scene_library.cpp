@@ -49,7 +49,7 @@ TEST(SimSceneLibrary, NamedPathsStayInsideAndClearOfObstacles) {
   for (const std::string& scene : scene_names()) {
     const mesh::TriangleMesh mesh = build_scene(scene);
     const RayCaster caster(mesh);
-    for (const std::string& name : path_names()) {
+    for (const std::string& name : path_names(scene)) {
       const NamedPath path = scene_path(scene, name);
       const auto trajectory = make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);
       EXPECT_GT(trajectory->duration_s(), 5.0) << scene << " " << name;

@@ -3,112 +3,23 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "featsense/slam/sim/measurement_model.hpp"
+#include "scene_parts.hpp"
+#include "scene_town.hpp"
+#include "street_route.hpp"
 
 namespace featsense::slam {
 namespace {
 
-using V = Eigen::Vector3f;
-
-// Diffuse reflectances at 865 nm (Ouster's wavelength), rounded typical values: vegetation
-// is bright in the near infrared, asphalt and glass dark.
-struct Materials {
-  static constexpr float kPlaster = 0.65f;
-  static constexpr float kConcrete = 0.35f;
-  static constexpr float kFloorTiles = 0.4f;
-  static constexpr float kWood = 0.45f;
-  static constexpr float kMetal = 0.3f;
-  static constexpr float kAsphalt = 0.08f;
-  static constexpr float kGlass = 0.04f;
-  static constexpr float kFoliage = 0.5f;
-  static constexpr float kBark = 0.2f;
-  static constexpr float kTyre = 0.03f;
-};
-
-/// A deterministic uniform draw in [lo, hi) for procedural placement.
-float draw(uint64_t stream, uint32_t a, uint32_t b, float lo, float hi) {
-  return lo + (hi - lo) * static_cast<float>(hashed_uniform(0x5CE4E, stream, a, b, 0));
-}
-
-/// Vertical walls: in the plane x = const from y0 to y1, or y = const from x0 to x1.
-void add_wall_x(mesh::TriangleMesh& m, float x, float y0, float y1, float z0, float z1,
-                uint32_t part) {
-  m.add_quad(V(x, y0, z0), V(x, y1, z0), V(x, y1, z1), V(x, y0, z1), part);
-}
-void add_wall_y(mesh::TriangleMesh& m, float y, float x0, float x1, float z0, float z1,
-                uint32_t part) {
-  m.add_quad(V(x0, y, z0), V(x1, y, z0), V(x1, y, z1), V(x0, y, z1), part);
-}
-
-void add_table(mesh::TriangleMesh& m, float x0, float y0, float x1, float y1, uint32_t part) {
-  m.add_box(V(x0, y0, 0.72f), V(x1, y1, 0.76f), part);
-  const float leg = 0.05f;
-  for (float x : {x0, x1 - leg}) {
-    for (float y : {y0, y1 - leg}) m.add_box(V(x, y, 0.0f), V(x + leg, y + leg, 0.72f), part);
-  }
-}
-
-/// Open shelving: two side panels, a back panel and five shelves, front facing -y.
-void add_shelving(mesh::TriangleMesh& m, float x0, float x1, float y0, float depth, uint32_t part) {
-  const float height = 2.2f;
-  const float t = 0.03f;
-  m.add_box(V(x0, y0, 0), V(x0 + t, y0 + depth, height), part);
-  m.add_box(V(x1 - t, y0, 0), V(x1, y0 + depth, height), part);
-  m.add_box(V(x0, y0 + depth - t, 0), V(x1, y0 + depth, height), part);
-  for (int k = 0; k < 5; ++k) {
-    const float z = 0.1f + 0.5f * static_cast<float>(k);
-    m.add_box(V(x0, y0, z), V(x1, y0 + depth, z + t), part);
-  }
-}
-
-/// A tree: a trunk and a crown of many small irregular facets (as foliage gives lidar
-/// returns that change from scan to scan).
-void add_tree(mesh::TriangleMesh& m, float x, float y, uint32_t index, uint32_t trunk,
-              uint32_t foliage) {
-  m.add_cylinder(V(x, y, 0), 0.15f, 2.6f, 8, trunk);
-  const V centre(x, y, 4.2f);
-  const float radius = draw(1, index, 0, 1.6f, 2.2f);
-  for (uint32_t k = 0; k < 700; ++k) {
-    // A point in the crown's ellipsoid, then a facet of about 25 cm around it.
-    V p;
-    uint32_t attempt = 0;
-    do {
-      p = V(draw(2, index, 3 * k + attempt * 7919, -1, 1),
-            draw(3, index, 3 * k + attempt * 7919, -1, 1),
-            draw(4, index, 3 * k + attempt * 7919, -1, 1));
-      ++attempt;
-    } while (p.squaredNorm() > 1.0f && attempt < 16);
-    const V at = centre + radius * V(p.x(), p.y(), 0.8f * p.z());
-    V corners[3];
-    for (uint32_t c = 0; c < 3; ++c) {
-      corners[c] =
-          at + V(draw(5, index, 3 * k + c, -0.15f, 0.15f), draw(6, index, 3 * k + c, -0.15f, 0.15f),
-                 draw(7, index, 3 * k + c, -0.15f, 0.15f));
-    }
-    m.add_triangle(corners[0], corners[1], corners[2], foliage);
-  }
-}
-
-/// A car parked with its length along y: body, cabin, wheels.
-void add_car(mesh::TriangleMesh& m, float x, float y0, uint32_t index, uint32_t tyre) {
-  static const float kPaint[] = {0.04f, 0.3f, 0.55f, 0.85f, 0.2f};  // black ... white
-  const uint32_t paint = m.add_part("car body", kPaint[index % 5]);
-  const uint32_t glass = m.add_part("car window", Materials::kGlass);
-  const float w = 1.8f;
-  const float l = 4.5f;
-  m.add_box(V(x, y0, 0.3f), V(x + w, y0 + l, 1.0f), paint);
-  m.add_box(V(x + 0.1f, y0 + 1.2f, 1.0f), V(x + w - 0.1f, y0 + 3.6f, 1.5f), glass);
-  for (float wy : {y0 + 0.6f, y0 + l - 1.3f}) {
-    m.add_box(V(x - 0.02f, wy, 0), V(x + 0.25f, wy + 0.7f, 0.65f), tyre);
-    m.add_box(V(x + w - 0.25f, wy, 0), V(x + w + 0.02f, wy + 0.7f, 0.65f), tyre);
-  }
-}
-
-void add_light_pole(mesh::TriangleMesh& m, float x, float y, uint32_t metal) {
-  m.add_cylinder(V(x, y, 0), 0.1f, 8.0f, 10, metal);
-  m.add_box(V(x - 0.05f, y - 0.05f, 7.9f), V(x + 1.5f, y + 0.05f, 8.0f), metal);
-  m.add_box(V(x + 1.1f, y - 0.25f, 7.7f), V(x + 1.7f, y + 0.25f, 7.9f), metal);
-}
+using scene_parts::add_car;
+using scene_parts::add_light_pole;
+using scene_parts::add_shelving;
+using scene_parts::add_table;
+using scene_parts::add_tree;
+using scene_parts::add_wall_x;
+using scene_parts::add_wall_y;
+using scene_parts::draw;
+using scene_parts::Materials;
+using scene_parts::V;
 
 /// 20 x 20 x 4 m room (x, y in [-10, 10]) with pillars, tables, shelving, a closed door in
 /// the west wall and an open door (1.2 x 2.2 m) in the east wall to a 2 m wide corridor.
@@ -224,11 +135,14 @@ mesh::TriangleMesh parking() {
   return m;
 }
 
-std::string unknown(const std::string& what, const std::string& name,
-                    const std::vector<std::string>& names) {
-  std::string message = "unknown " + what + " '" + name + "' (built-in: ";
-  for (size_t i = 0; i < names.size(); ++i) message += (i ? ", " : "") + names[i];
-  return message + ")";
+std::string listed(const std::vector<std::string>& names) {
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
+  return list;
+}
+
+std::string unknown_scene(const std::string& name) {
+  return "unknown scene '" + name + "' (built-in: " + listed(scene_names()) + ")";
 }
 
 std::vector<Eigen::Vector3d> at_height(const std::vector<Eigen::Vector2d>& xy, double z) {
@@ -237,9 +151,20 @@ std::vector<Eigen::Vector3d> at_height(const std::vector<Eigen::Vector2d>& xy, d
   return out;
 }
 
+/// Twice round the open east end of the lot, then back west along the north lane: about
+/// 240 m at 5 m/s, each lap's 70 m driven again 70 m later in the same direction.
+std::vector<Eigen::Vector3d> parking_loop() {
+  using P = Eigen::Vector2d;
+  RouteShape shape;
+  shape.turn_radius_m = 5.0;
+  const std::vector<P> corners = {P(5, 10.75),  P(85, 10.75), P(85, 27.25), P(64, 27.25),
+                                  P(64, 10.75), P(85, 10.75), P(85, 27.25), P(5, 27.25)};
+  return at_height(street_route(corners, shape), 1.9);
+}
+
 }  // namespace
 
-std::vector<std::string> scene_names() { return {"corridor", "lab", "parking"}; }
+std::vector<std::string> scene_names() { return {"corridor", "lab", "parking", "town"}; }
 
 bool is_builtin_scene(const std::string& name) {
   for (const std::string& s : scene_names()) {
@@ -252,18 +177,26 @@ mesh::TriangleMesh build_scene(const std::string& name) {
   if (name == "lab") return lab();
   if (name == "parking") return parking();
   if (name == "corridor") return corridor();
-  throw std::invalid_argument(unknown("scene", name, scene_names()));
+  if (name == "town") return town::build_town();
+  throw std::invalid_argument(unknown_scene(name));
 }
 
-std::vector<std::string> path_names() { return {"walk", "drive", "drone"}; }
+std::vector<std::string> path_names(const std::string& scene) {
+  if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown_scene(scene));
+  if (scene == "town") return town::town_path_names();
+  if (scene == "parking") return {"walk", "drive", "drone", "loop"};
+  return {"walk", "drive", "drone"};
+}
 
 NamedPath scene_path(const std::string& scene, const std::string& path) {
   using P = Eigen::Vector2d;
   using W = Eigen::Vector3d;
-  if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown("scene", scene, scene_names()));
+  if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown_scene(scene));
   NamedPath out;
   out.name = path;
-  if (scene == "lab") {
+  if (scene == "town") {
+    out = town::town_path(path);
+  } else if (scene == "lab") {
     if (path == "walk") {
       out.waypoints_m = at_height({P(-7.5, -7.5), P(0, -7.5), P(7.5, -7), P(7.5, 0), P(7, 7.5),
                                    P(0, 7.5), P(-7.5, 7), P(-7.5, 0), P(-3, -4.5)},
@@ -311,9 +244,14 @@ NamedPath scene_path(const std::string& scene, const std::string& path) {
                          W(45, 26, 5), W(30, 28, 2.5), W(15, 26, 4),   W(5, 27, 3)};
       out.speed_mps = 6.0;
       out.tilt = true;
+    } else if (path == "loop") {
+      out.waypoints_m = parking_loop();
+      out.speed_mps = 5.0;
     }
   }
-  if (out.waypoints_m.empty()) throw std::invalid_argument(unknown("path", path, path_names()));
+  if (out.waypoints_m.empty())
+    throw std::invalid_argument("unknown path '" + path + "' of the " + scene +
+                                " scene (its paths: " + listed(path_names(scene)) + ")");
   return out;
 }
 

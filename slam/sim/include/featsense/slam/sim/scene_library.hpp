@@ -11,7 +11,11 @@
 
 namespace featsense::slam {
 
-/// Names of the built-in scenes: "corridor", "lab", "parking".
+/// Names of the built-in scenes: "corridor", "lab", "parking", "town". The town: a 4 x 3
+/// grid of blocks (x in [0, 200], y in [0, 150] between the outer streets' centre lines, on
+/// a 50 m grid, 12 m carriageways) closed by outer rows of buildings; the ground rises 3 m
+/// between x = 156 and 194; blocks (0, 1) and (2, 1), with their lower-left street crossings
+/// at (0, 50) and (100, 50), are alike (the same mesh moved 100 m along x).
 std::vector<std::string> scene_names();
 /// True when `name` is a built-in scene.
 bool is_builtin_scene(const std::string& name);
@@ -27,10 +31,12 @@ struct NamedPath {
   bool tilt = false;  ///< roll into turns and pitch with climbs, as a multirotor does
 };
 
-/// Names of the paths of a built-in scene: "walk", "drive", "drone".
-std::vector<std::string> path_names();
+/// Names of the paths of a built-in scene: "walk", "drive", "drone" (lab, corridor), and
+/// "loop" (parking); "loop", "drive", "walk" (town). Throws std::invalid_argument naming the
+/// scenes when `scene` is unknown.
+std::vector<std::string> path_names(const std::string& scene);
 /// A named path through a built-in scene; throws std::invalid_argument when either name is
-/// unknown.
+/// unknown (naming the scenes, or that scene's paths).
 NamedPath scene_path(const std::string& scene, const std::string& path);
 
 }  // namespace featsense::slam
