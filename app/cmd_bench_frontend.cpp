@@ -5,6 +5,8 @@
 // the mapping run does, and gives the trajectory's error where the truth is known.
 
 #include <chrono>
+#include <cmath>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,7 +15,9 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
+#include "featsense/slam/refine/refinement_cloud.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
@@ -35,6 +39,7 @@ struct BenchFrontEndOptions {
   std::string estimate_out;     ///< bench odometry: the estimated poses, TUM
   bool refine = false;          ///< bench odometry: the map refinement too (refine.*)
   std::string refined_out;      ///< bench odometry --refine: the refined poses, TUM
+  bool loops = false;           ///< bench odometry: loop closure over the final poses (loop.*)
   InputOptions input;
   int scans = 100;
   std::optional<std::string> json_path;
@@ -160,7 +165,9 @@ class BenchRefinement {
         refiner_(settings_),
         deskew_(config.odometry.deskew) {}
 
-  void add(const slam::Scan& scan, const slam::odometry::OdometryResult& odometry) {
+  /// The placements made final by this scan (with their scans' sequence numbers).
+  std::vector<slam::ScanPlacement> add(const slam::Scan& scan,
+                                       const slam::odometry::OdometryResult& odometry) {
     if (odometry.elapsed_s > 0.0) {
       motion_ = odometry.T_previous_sensor;
       period_s_ = odometry.elapsed_s;
@@ -175,14 +182,12 @@ class BenchRefinement {
                                                 slam::motion_fraction(motion_, t / period_s_));
       });
     }
-    take(refiner_.add(scan, std::move(placed)));
+    return take(refiner_.add(scan, std::move(placed)));
   }
 
-  /// The poses of the scans still held, refined as a shorter stretch.
-  const slam::Trajectory& finish() {
-    take(refiner_.finish());
-    return refined_;
-  }
+  /// The scans still held, refined as a shorter stretch.
+  std::vector<slam::ScanPlacement> finish() { return take(refiner_.finish()); }
+  const slam::Trajectory& refined() const { return refined_; }
 
   nlohmann::json json() const {
     const slam::refine::RefineCounts& counts = refiner_.counts();
@@ -228,9 +233,10 @@ class BenchRefinement {
     return static_cast<double>(refined_.stamps_ns.back() - refined_.stamps_ns.front()) * 1e-6;
   }
 
-  void take(const std::vector<slam::ScanPlacement>& placements) {
+  std::vector<slam::ScanPlacement> take(std::vector<slam::ScanPlacement> placements) {
     for (const slam::ScanPlacement& placement : placements)
       refined_.push_back(placement.stamp_ns, placement.T_map_sensor);
+    return placements;
   }
 
   slam::refine::RefineSettings settings_;
@@ -239,6 +245,106 @@ class BenchRefinement {
   Eigen::Isometry3d motion_ = Eigen::Isometry3d::Identity();
   double period_s_ = 0.0;
   slam::Trajectory refined_;
+};
+
+/// Loop closure over the final poses, as the mapping run does it but in line and timed: the
+/// keyframes' clouds, the search, the verification and the solves, and what the loops did to
+/// the path.
+class BenchLoops {
+ public:
+  explicit BenchLoops(const config::Config& config)
+      : settings_(slam::loops::from_config(config)),
+        selector_(settings_.keyframe_distance_m, settings_.keyframe_angle_deg),
+        closer_(settings_) {}
+
+  void add(const slam::Scan& scan, const slam::ScanPlacement& placement) {
+    const bool keyframe = selector_.next(placement.T_map_sensor);
+    path_.push_back(placement.stamp_ns, placement.T_map_sensor);
+    travelled_m_.push_back(selector_.travelled_m());
+    if (!keyframe) return;
+    const auto start = Clock::now();
+    const std::vector<Eigen::Vector3f> points =
+        slam::refine::voxel_centroids(scan, placement, settings_.cloud_voxel_m);
+    cloud_ms_.push_back(ms_since(start));
+    closer_.add_keyframe(placement.stamp_ns, selector_.travelled_m(), placement.T_map_sensor,
+                         points);
+    keyframe_stamps_ns_.push_back(placement.stamp_ns);
+  }
+
+  /// The corrected poses of every scan added.
+  slam::Trajectory finish() {
+    if (!closer_.loops().empty()) closer_.optimise();
+    const slam::loops::TrajectoryCorrection correction = closer_.correction();
+    slam::Trajectory corrected;
+    for (size_t i = 0; i < path_.size(); ++i)
+      corrected.push_back(path_.stamps_ns[i], correction.apply(travelled_m_[i], path_.poses[i]));
+    return corrected;
+  }
+
+  /// Counts and times; with the truth, each loop's measured pose against it: a loop more than
+  /// 0.3 m or 2 degrees off is false (it would bend the map).
+  nlohmann::json json(const std::optional<slam::Trajectory>& truth) const {
+    const slam::loops::LoopCounts& counts = closer_.counts();
+    nlohmann::json rejected = nlohmann::json::object();
+    for (const auto& [reason, count] : counts.rejected) rejected[reason] = count;
+    double total_ms = 0.0;
+    for (const double ms : counts.keyframe_ms) total_ms += ms;
+    for (const double ms : cloud_ms_) total_ms += ms;
+    const double recorded_ms =
+        path_.size() < 2
+            ? 0.0
+            : static_cast<double>(path_.stamps_ns.back() - path_.stamps_ns.front()) * 1e-6;
+    nlohmann::json out = {{"keyframes", counts.keyframes},
+                          {"candidates", counts.candidates},
+                          {"verified", counts.verified},
+                          {"accepted", closer_.loops().size()},
+                          {"rejected", rejected},
+                          {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
+                          {"cloud", timing_json(cloud_ms_)},
+                          {"keyframe", timing_json(counts.keyframe_ms)},
+                          {"optimise", timing_json(counts.optimise_ms)},
+                          // The loop closure's time against the recording's: above 1 it
+                          // keeps up with the sensor on one core.
+                          {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)}};
+    if (!truth) return out;
+    size_t false_loops = 0;
+    double worst_m = 0.0, worst_deg = 0.0;
+    size_t k = 0;
+    for (const slam::loops::PoseGraphEdge& edge : closer_.graph().edges()) {
+      if (!edge.loop) continue;
+      ++k;
+      const std::optional<Eigen::Isometry3d> from = truth_at(*truth, keyframe_stamps_ns_[edge.from]);
+      const std::optional<Eigen::Isometry3d> to = truth_at(*truth, keyframe_stamps_ns_[edge.to]);
+      if (!from || !to) continue;
+      const Eigen::Isometry3d error = (from->inverse() * *to).inverse() * edge.T_from_to;
+      const double m = error.translation().norm();
+      const double deg = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
+      worst_m = std::max(worst_m, m);
+      worst_deg = std::max(worst_deg, deg);
+      if (m > 0.3 || deg > 2.0) ++false_loops;
+    }
+    out["false_loops"] = false_loops;
+    out["worst_loop_error_m"] = worst_m;
+    out["worst_loop_error_deg"] = worst_deg;
+    return out;
+  }
+
+ private:
+  static std::optional<Eigen::Isometry3d> truth_at(const slam::Trajectory& truth,
+                                                   int64_t stamp_ns) {
+    for (size_t i = 0; i < truth.size(); ++i) {
+      if (truth.stamps_ns[i] == stamp_ns) return truth.poses[i];
+    }
+    return std::nullopt;
+  }
+
+  slam::loops::LoopSettings settings_;
+  slam::loops::KeyframeSelector selector_;
+  slam::loops::LoopCloser closer_;
+  slam::Trajectory path_;
+  std::vector<double> travelled_m_;
+  std::vector<double> cloud_ms_;
+  std::vector<int64_t> keyframe_stamps_ns_;
 };
 
 /// The trajectory's error against the truth, as JSON (nothing where it is undetermined).
@@ -264,6 +370,18 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   slam::odometry::FeatureOdometry odometry(slam::odometry::from_config(config));
   std::optional<BenchRefinement> refinement;
   if (options.refine) refinement.emplace(config);
+  std::optional<BenchLoops> loops;
+  if (options.loops) loops.emplace(config);
+  // With the refinement, the scans wait for their final poses before the loops see them.
+  std::deque<slam::Scan> held;
+  const auto to_loops = [&](const std::vector<slam::ScanPlacement>& final) {
+    for (const slam::ScanPlacement& placement : final) {
+      while (!held.empty() && held.front().sequence != placement.sequence) held.pop_front();
+      if (held.empty()) continue;
+      loops->add(held.front(), placement);
+      held.pop_front();
+    }
+  };
 
   std::vector<double> features_ms, registration_ms, total_ms, feature_counts;
   std::vector<double> association_ms, solve_ms, map_update_ms;
@@ -282,7 +400,17 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
     const double features = std::chrono::duration<double, std::milli>(extracted - start).count();
     estimate.stamps_ns.push_back(scan->stamp_ns);
     estimate.poses.push_back(result.T_map_sensor);
-    if (refinement) refinement->add(*scan, result);
+    if (loops && refinement) held.push_back(*scan);
+    if (refinement) {
+      const std::vector<slam::ScanPlacement> final = refinement->add(*scan, result);
+      if (loops) to_loops(final);
+    } else if (loops) {
+      slam::ScanPlacement placement;
+      placement.sequence = scan->sequence;
+      placement.stamp_ns = scan->stamp_ns;
+      placement.T_map_sensor = result.T_map_sensor;
+      loops->add(*scan, placement);
+    }
     last = result;
     if (result.diagnostics.degenerate) ++degenerate;
     if (i > 0 && !result.diagnostics.converged) ++failed;
@@ -324,11 +452,19 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   if (!options.estimate_out.empty()) slam::write_tum(estimate, options.estimate_out);
   if (scans.truth()) add_trajectory_error(estimate, *scans.truth(), result);
   if (refinement) {
-    const slam::Trajectory& refined = refinement->finish();
+    const std::vector<slam::ScanPlacement> final = refinement->finish();
+    if (loops) to_loops(final);
+    const slam::Trajectory& refined = refinement->refined();
     if (!options.refined_out.empty()) slam::write_tum(refined, options.refined_out);
     nlohmann::json refine = refinement->json();
     if (scans.truth()) add_trajectory_error(refined, *scans.truth(), refine);
     result["refine"] = refine;
+  }
+  if (loops) {
+    const slam::Trajectory corrected = loops->finish();
+    nlohmann::json closed = loops->json(scans.truth());
+    if (scans.truth()) add_trajectory_error(corrected, *scans.truth(), closed);
+    result["loops"] = closed;
   }
   return result;
 }
@@ -362,6 +498,9 @@ Command add_front_end_bench(CLI::App& bench, const char* name, const char* help,
                       "Refine the poses too (refine.*): its ms, and the refined poses' error");
     command->add_option("--refined-out", options->refined_out,
                         "With --refine: write the refined poses here (TUM)");
+    command->add_flag("--loops", options->loops,
+                      "Close loops over the final poses (loop.*): ms per keyframe, the loops, "
+                      "false ones against the truth, the corrected poses' error");
   }
   return {command, [options, run, &context] {
             print_bench_result(run(*options, context), options->json_path);
