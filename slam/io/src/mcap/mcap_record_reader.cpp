@@ -65,6 +65,7 @@ void McapRecordReader::jump_to(uint64_t offset) {
   finished_ = false;
   sequential_ = false;
   summary_from_.reset();
+  footer_.reset();
   offset_ = offset;
   stream_.clear();
   stream_.seekg(static_cast<std::streamoff>(offset));
