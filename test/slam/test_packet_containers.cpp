@@ -237,5 +237,74 @@ TEST(PacketContainers, Vlp16FiresTwiceABlock) {
   }
 }
 
+TEST(PacketContainers, ModelFromThePresetWhereThePacketsNameNone) {
+  FEATSENSE_SHARED_FILE(calibration, "velodyne/calibration/HDL64e_s3.yaml");
+  // HDL-64E packets carry no product id; upper (FF EE) and lower (FF DD) blocks alternate.
+  std::vector<test::CapturedFrame> frames;
+  for (uint16_t p = 0; p < 40; ++p) {
+    std::vector<uint8_t> packet =
+        synthetic_packet(static_cast<uint16_t>(p * 120), 20, 5000, 0x37, 0x00, /*dual_pairs=*/true);
+    for (size_t block = 1; block < kVelodyneBlocks; block += 2) {
+      packet[block * kVelodyneBlockBytes + 1] = 0xDD;
+    }
+    test::CapturedFrame frame;
+    frame.seconds = 1700000000;
+    frame.fraction = p * 300u;
+    frame.bytes = test::ethernet_ipv4_udp(packet, 2368, p);
+    frames.push_back(std::move(frame));
+  }
+  const auto dir = test::scratch_dir("velodyne_preset");
+  test::write_file(dir / "hdl64.pcap", test::write_pcap(frames));
+  try {
+    open_scan_source((dir / "hdl64.pcap").string());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("set sensor.preset"), std::string::npos) << e.what();
+  }
+  SourceOptions options;
+  options.sensor_preset = "hdl64";
+  try {
+    open_scan_source((dir / "hdl64.pcap").string(), options);
+    FAIL() << "no error";
+  } catch (const InputError& e) {  // no built-in table for the HDL-64E
+    EXPECT_NE(std::string(e.what()).find("sensor.calibration"), std::string::npos) << e.what();
+  }
+  options.velodyne_calibration = calibration.string();
+  std::unique_ptr<ScanSource> source = open_scan_source((dir / "hdl64.pcap").string(), options);
+  EXPECT_NE(source->info().detail.find("HDL-64E (sensor.preset hdl64)"), std::string::npos)
+      << source->info().detail;
+  const std::vector<Scan> scans = all_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  EXPECT_EQ(scans[0].rows, 64);
+  EXPECT_EQ(scans[0].valid_count(), 40u * 6u * 64u);
+}
+
+TEST(PacketContainers, ScansBeginAtTheCutAngle) {
+  FEATSENSE_SHARED_FILE(bag, kVelodyneBag);
+  // Cut at 0 deg, inside the fired sector (270 .. 90): a scan is a turn from the front to
+  // the front, the right quarter (0 .. 90 deg) of one sweep, then the silent back half, then
+  // the left quarter (270 .. 360) of the next.
+  SourceOptions options;
+  options.scan_cut_deg = 0.0;
+  std::unique_ptr<ScanSource> source = open_scan_source(bag.string(), options);
+  const std::vector<Scan> scans = all_scans(*source);
+  ASSERT_EQ(scans.size(), 6u);  // the first sweep's left quarter, then five turns
+  for (size_t s = 0; s < scans.size(); ++s) {
+    float last = 0.0f;
+    for (size_t i = 0; i < scans[s].size(); ++i) {
+      if (!scans[s].valid[i]) continue;
+      last = std::max(last, scans[s].time_offset_s[i]);
+      // Right of the sensor (y < 0) first, left of it a half turn later.
+      if (scans[s].xyz[i].y() < -1.0f) {
+        EXPECT_LT(scans[s].time_offset_s[i], 0.03f);
+      }
+      if (s > 0 && scans[s].xyz[i].y() > 1.0f) {
+        EXPECT_GT(scans[s].time_offset_s[i], 0.07f);
+      }
+    }
+    EXPECT_LT(last, s == 0 ? 0.03f : 0.105f);
+  }
+}
+
 }  // namespace
 }  // namespace featsense::slam
