@@ -7,6 +7,7 @@
 
 #include "featsense/slam/scan_source.hpp"
 #include "rosbag/chunk_decompress.hpp"
+#include "stream_size.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -44,13 +45,7 @@ std::string hex32(uint32_t value) {
 McapRecordReader::McapRecordReader(std::istream& stream, std::string origin,
                                    McapReadOptions options)
     : stream_(stream), origin_(std::move(origin)), options_(std::move(options)) {
-  stream_.clear();
-  stream_.seekg(0, std::ios::end);
-  const std::streamoff end = stream_.tellg();
-  if (!stream_ || end < 0) throw InputError(origin_ + ": cannot tell its size (not a file?)");
-  file_size_ = static_cast<uint64_t>(end);
-  stream_.seekg(0);
-  if (file_size_ == 0) throw InputError(origin_ + ": empty file");
+  file_size_ = nonempty_stream_size(stream_, origin_);
   uint8_t magic[sizeof kMcapMagic] = {};
   if (!read_exactly(magic, std::min<uint64_t>(sizeof magic, file_size_)) ||
       std::memcmp(magic, kMcapMagic, sizeof magic) != 0) {
