@@ -77,6 +77,7 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
                  {"rows", same_shape ? rows : -1},
                  {"cols", same_shape ? cols : -1},
                  {"fields", info.fields},
+                 {"topics", info.topics},
                  {"times", info.times},
                  {"valid_points", valid},
                  {"time_span_s", span_s},
@@ -104,6 +105,9 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
   }
   t += line;
   t += "fields:    " + join(info.fields) + "\n";
+  for (size_t i = 0; i < info.topics.size(); ++i) {
+    t += (i == 0 ? "topics:    " : "           ") + info.topics[i] + "\n";
+  }
   t += "times:     " + (info.times.empty() ? std::string("unknown") : info.times) + "\n";
   std::snprintf(line, sizeof line, "valid points per frame: min %.0f, median %.0f, max %.0f\n",
                 valid["min"].get<double>(), valid["median"].get<double>(),

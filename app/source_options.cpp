@@ -9,8 +9,9 @@ namespace featsense::app {
 void InputOptions::add_to(CLI::App& command, bool input_optional) {
   auto* positional = command.add_option(
       "INPUT", input,
-      "Recording: Ouster pcap, ROS1 bag, PCD or PLY file, or a folder of KITTI .bin / PCD / "
-      "PLY scans or of `featsense simulate`");
+      "Recording: Ouster or Velodyne pcap, ROS1 bag, ROS 2 bag (folder or .db3), MCAP file, "
+      "PCD or PLY file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense "
+      "simulate`");
   if (input_optional) {
     positional->description(positional->get_description() +
                             " (default: a built-in example, an analytic box room)");
@@ -19,7 +20,9 @@ void InputOptions::add_to(CLI::App& command, bool input_optional) {
   }
   command.add_option("--meta", meta_path, "Ouster metadata JSON (default: found beside the pcap)")
       ->check(CLI::ExistingFile);
-  command.add_option("--topic", topic, "ROS bag topic to read (default: the one scan topic)");
+  command.add_option(
+      "--topic", topic,
+      "Bag or MCAP topic to read (default: the one scan topic; `featsense info` lists them)");
 }
 
 std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& config) const {
@@ -39,6 +42,8 @@ std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& confi
   options.min_range_m = config.sensor.min_range_m;
   options.max_range_m = config.sensor.max_range_m;
   options.times_from_azimuth = config.sensor.times_from_azimuth;
+  options.velodyne_calibration = config.sensor.calibration;
+  options.scan_cut_deg = config.sensor.scan_cut_deg;
   return slam::open_scan_source(input, options);
 }
 

@@ -18,6 +18,9 @@ find_package(OpenVDB REQUIRED)
 find_package(liblzf CONFIG REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+# ROS 2 bags (sqlite3 storage) and MCAP's zstd chunks (slam/io).
+find_package(SQLite3 REQUIRED)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
 # The simulator: Embree casts the rays (slam/sim); assimp reads mesh files (viewer_export), the
 # simulator's scene files among them.
 find_package(embree 3 CONFIG REQUIRED)

@@ -162,6 +162,26 @@ KeySpec backend_key() {
           [](const Config& c) { return YAML::Node(to_string(c.map.backend)); }};
 }
 
+/// A file path that may be unset (null).
+template <typename Section>
+KeySpec optional_path_key(std::string path, SectionOf<Section> section,
+                          Member<Section, std::optional<std::string>> field) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            if (v.IsNull()) {
+              (c.*section).*field = std::nullopt;
+            } else if (!v.IsScalar() || v.Scalar().empty()) {
+              fail(where, "expected a file path or null");
+            } else {
+              (c.*section).*field = v.Scalar();
+            }
+          },
+          [=](const Config& c) {
+            const auto& value = (c.*section).*field;
+            return value ? YAML::Node(*value) : YAML::Node(YAML::NodeType::Null);
+          }};
+}
+
 std::vector<KeySpec> make_specs() {
   return {
       preset_key(),
@@ -171,6 +191,8 @@ std::vector<KeySpec> make_specs() {
                           {0.0, 10000.0, true}),
       bool_key("sensor.drop_mixed_pixels", &Config::sensor, &SensorConfig::drop_mixed_pixels),
       bool_key("sensor.times_from_azimuth", &Config::sensor, &SensorConfig::times_from_azimuth),
+      optional_path_key("sensor.calibration", &Config::sensor, &SensorConfig::calibration),
+      number_key("sensor.scan_cut_deg", &Config::sensor, &SensorConfig::scan_cut_deg, {0.0, 360.0}),
       number_key("map.voxel_size", &Config::map, &MapConfig::voxel_size_m, {0.005, 2.0}),
       number_key("map.truncation", &Config::map, &MapConfig::truncation_m, {0.0, 10.0, true}),
       number_key("map.max_weight", &Config::map, &MapConfig::max_weight, {1.0, 500.0}),

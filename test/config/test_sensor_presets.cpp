@@ -11,8 +11,8 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 TEST(SensorPresets, AllPresetsOfTheDesignExistAndAreValid) {
-  const std::vector<std::string> expected = {"hdl32",   "hdl64",  "os0-128",
-                                             "os1-128", "os1-64", "vlp16"};
+  const std::vector<std::string> expected = {"hdl32",  "hdl64", "os0-128", "os1-128",
+                                             "os1-64", "vlp16", "vlp32c",  "vls128"};
   EXPECT_EQ(sensor_preset_names(), expected);
   for (const auto& name : expected) {
     const SensorModel model = sensor_preset(name);
@@ -30,6 +30,9 @@ TEST(SensorPresets, GeometryMatchesTheDataSheets) {
   EXPECT_NEAR(vlp16.vertical_fov_rad(), 30 * kDeg, 1e-12);
 
   EXPECT_NEAR(sensor_preset("os1-128").vertical_fov_rad(), 45 * kDeg, 1e-12);
+  // Velodyne's manuals: VLP-32C and VLS-128 from +15 to -25 deg.
+  EXPECT_NEAR(sensor_preset("vlp32c").vertical_fov_rad(), 40 * kDeg, 1e-12);
+  EXPECT_NEAR(sensor_preset("vls128").vertical_fov_rad(), 40 * kDeg, 1e-4);
   EXPECT_NEAR(sensor_preset("os0-128").vertical_fov_rad(), 90 * kDeg, 1e-12);
   EXPECT_EQ(sensor_preset("os1-64").beams, 64);
   const SensorModel hdl32 = sensor_preset("hdl32");

@@ -56,7 +56,15 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
   std::error_code ec;
   const fs::file_status status = fs::status(input, ec);
   if (ec || !fs::exists(status)) throw InputError(input + ": no such file or folder");
-  if (fs::is_directory(status)) return open_scan_folder(input, options);
+  if (fs::is_directory(status)) {
+    // rosbag2 writes metadata.yaml beside the files of every bag it closes.
+    if (fs::is_regular_file(fs::path(input) / "metadata.yaml"))
+      return open_ros2_bag(input, options);
+    return open_scan_folder(input, options);
+  }
+  if (fs::path(input).filename() == "metadata.yaml") {
+    return open_ros2_bag(fs::path(input).parent_path().string(), options);
+  }
   if (!fs::is_regular_file(status)) throw InputError(input + ": not a regular file");
 
   std::ifstream file(input, std::ios::binary);
@@ -71,6 +79,7 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
     std::memcpy(&magic, head.data(), 4);
     if (magic == 0xa1b2c3d4u || magic == 0xd4c3b2a1u || magic == 0xa1b23c4du ||
         magic == 0x4d3cb2a1u) {
+      if (is_velodyne_pcap(input)) return open_velodyne_pcap(input, options);
       return open_ouster_pcap(input, options);
     }
     if (magic == 0x0a0d0d0au) {
@@ -79,6 +88,10 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
     }
   }
   if (starts_with(head, "#ROSBAG V2.0")) return open_rosbag(input, options);
+  if (starts_with(head, std::string_view("SQLite format 3\0", 16))) {
+    return open_ros2_bag(input, options);
+  }
+  if (starts_with(head, std::string_view("\x89MCAP0\r\n", 8))) return open_mcap(input, options);
   if (starts_with(head, "#ROSBAG")) {
     throw InputError(input + ": only ROS bag format 2.0 is supported (ROS 1 bags)");
   }
@@ -90,8 +103,9 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
     throw InputError(input + ": a single KITTI .bin; pass the folder that holds the scans");
   }
   throw InputError(input +
-                   ": unrecognised format (expected an Ouster pcap, a ROS1 bag, a PCD or PLY "
-                   "file, or a folder of scans)");
+                   ": unrecognised format (expected an Ouster or Velodyne pcap, a ROS1 bag, a "
+                   "ROS 2 bag folder or .db3, an MCAP file, a PCD or PLY file, or a folder of "
+                   "scans)");
 }
 
 }  // namespace

@@ -21,6 +21,11 @@ struct SensorConfig {
   /// PointCloud2 messages) get each point's time from its azimuth, where the points are
   /// stored in the order the sensor measured them (slam/io azimuth_times.hpp).
   bool times_from_azimuth = true;
+  /// A Velodyne calibration YAML (per-laser corrections); unset: the model's built-in table.
+  std::optional<std::string> calibration;
+  /// Where packet streams (Velodyne) are cut into scans: azimuth in degrees, clockwise from
+  /// +x (forward). 180 puts the seam behind the sensor.
+  double scan_cut_deg = 180.0;
 };
 
 enum class Backend { kAuto, kCuda, kCpu };

@@ -14,10 +14,14 @@
 
 namespace featsense::slam {
 
-/// All connections of one topic.
+/// How a topic's messages are serialized: ROS 1 (unpadded) or CDR (ROS 2).
+enum class MessageEncoding { kRos1, kCdr };
+
+/// All connections of one topic (ROS 1), or one topic of a ROS 2 bag or MCAP file.
 struct BagTopic {
   std::string name;
-  std::string type;                   ///< of its first connection
+  std::string type;  ///< of its first connection, ROS 1 style: "sensor_msgs/PointCloud2"
+  MessageEncoding encoding = MessageEncoding::kRos1;
   std::vector<uint32_t> connections;  ///< ids
   uint64_t messages = 0;
 };

@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "featsense/slam/scan_source.hpp"
+#include "stream_size.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -18,13 +19,7 @@ constexpr size_t kMaxCompressionNameBytes = 16;
 
 BagRecordReader::BagRecordReader(std::istream& stream, std::string origin, BagReadOptions options)
     : stream_(stream), origin_(std::move(origin)), options_(std::move(options)) {
-  stream_.clear();
-  stream_.seekg(0, std::ios::end);
-  const std::streamoff end = stream_.tellg();
-  if (!stream_ || end < 0) throw InputError(origin_ + ": cannot tell its size (not a file?)");
-  file_size_ = static_cast<uint64_t>(end);
-  stream_.seekg(0);
-  if (file_size_ == 0) throw InputError(origin_ + ": empty file");
+  file_size_ = nonempty_stream_size(stream_, origin_);
 
   std::string line(kVersionLine.size(), '\0');
   stream_.read(line.data(), static_cast<std::streamsize>(line.size()));

@@ -3,7 +3,7 @@
 /// decoder of that topic's message type.
 
 #include <functional>
-#include <istream>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -22,9 +22,21 @@ struct DecodeReport {
   std::function<void(const std::string&)> skip_frame;  ///< a skipped frame, with the reason
 };
 
+/// The messages of one topic in recording order, one at a time.
+class MessageCursor {
+ public:
+  virtual ~MessageCursor() = default;
+  /// The next message, or nullopt at the end; its data stays valid until the next call.
+  virtual std::optional<BagMessage> next() = 0;
+};
+
+/// A fresh pass over the messages of a topic, for a look at the first ones; damage met on
+/// the way is not reported (the streaming pass reports it).
+using TopicOpener = std::function<std::unique_ptr<MessageCursor>(const BagTopic& topic)>;
+
 /// What a decoder factory may look at while the bag is being opened.
 struct BagTopicContext {
-  std::istream& stream;  ///< the bag, for a look at the first messages (any position)
+  TopicOpener open_topic;
   const std::string& origin;
   const BagCatalog& catalog;
   const BagTopic& topic;  ///< the topic to decode
@@ -44,6 +56,9 @@ class BagScanDecoder {
   virtual std::optional<Scan> decode(const BagMessage& message, const DecodeReport& report) = 0;
   /// At the end of the bag: a scan still being assembled, if any.
   virtual std::optional<Scan> finish(const DecodeReport& /*report*/) { return std::nullopt; }
+  /// A further scan completed by the last message or finish() (a message of many packets
+  /// may complete several); asked for until it returns nullopt.
+  virtual std::optional<Scan> take_pending() { return std::nullopt; }
 };
 
 }  // namespace featsense::slam

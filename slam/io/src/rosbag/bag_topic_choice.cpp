@@ -37,9 +37,16 @@ std::string all_topics(const BagCatalog& catalog) {
 }
 
 constexpr const char* kSupported =
-    "sensor_msgs/PointCloud2, or ouster_ros/PacketMsg lidar packets with their metadata";
+    "sensor_msgs/PointCloud2, velodyne_msgs/VelodyneScan, or ouster_ros/PacketMsg lidar "
+    "packets with their metadata";
 
 }  // namespace
+
+std::string ros1_style_type(const std::string& type) {
+  const size_t at = type.find("/msg/");
+  if (at == std::string::npos) return type;
+  return type.substr(0, at) + "/" + type.substr(at + 5);
+}
 
 BagTopicKind classify_topic(const BagTopic& topic) {
   const std::string last = last_part(topic.name);
@@ -48,6 +55,7 @@ BagTopicKind classify_topic(const BagTopic& topic) {
     return last.find("imu") != std::string::npos ? BagTopicKind::kOusterImuPackets
                                                  : BagTopicKind::kOusterLidarPackets;
   }
+  if (topic.type == "velodyne_msgs/VelodyneScan") return BagTopicKind::kVelodyneScan;
   if (topic.type == "std_msgs/String" && last.find("metadata") != std::string::npos) {
     return BagTopicKind::kOusterMetadata;
   }
@@ -55,7 +63,8 @@ BagTopicKind classify_topic(const BagTopic& topic) {
 }
 
 bool is_scan_kind(BagTopicKind kind) {
-  return kind == BagTopicKind::kPointCloud2 || kind == BagTopicKind::kOusterLidarPackets;
+  return kind == BagTopicKind::kPointCloud2 || kind == BagTopicKind::kOusterLidarPackets ||
+         kind == BagTopicKind::kVelodyneScan;
 }
 
 const BagTopic& choose_scan_topic(const BagCatalog& catalog,

@@ -13,14 +13,19 @@ enum class BagTopicKind {
   kOusterLidarPackets,  ///< ouster_ros/PacketMsg (or ouster_sensor_msgs/) not named "imu"
   kOusterImuPackets,    ///< the same type on a topic whose last name part holds "imu"
   kOusterMetadata,      ///< std_msgs/String on a topic whose last name part holds "metadata"
+  kVelodyneScan,        ///< velodyne_msgs/VelodyneScan (raw Velodyne packets)
   kOther,
 };
+
+/// A ROS 2 type name in the ROS 1 style the topic kinds are told by:
+/// "sensor_msgs/msg/PointCloud2" -> "sensor_msgs/PointCloud2"; others stay as they are.
+std::string ros1_style_type(const std::string& type);
 
 /// Both Ouster packet topics have the same type; the driver names them `.../lidar_packets`
 /// and `.../imu_packets`, so the topic name tells them apart.
 BagTopicKind classify_topic(const BagTopic& topic);
 
-/// True for the kinds that yield scans (PointCloud2, Ouster lidar packets).
+/// True for the kinds that yield scans (PointCloud2, Ouster lidar packets, Velodyne scans).
 bool is_scan_kind(BagTopicKind kind);
 
 /// The topic to read: `wanted` where given (which must exist and hold scans), else the one

@@ -2,6 +2,7 @@
 
 #include <bzlib.h>
 #include <lz4frame.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <climits>
@@ -100,6 +101,40 @@ class Lz4FrameDecoder {
   bool ok_ = false;
 };
 
+/// libzstd's streaming decoder (MCAP's "zstd" chunks); it starts the next frame by itself.
+class ZstdDecoder {
+ public:
+  ZstdDecoder() : stream_(ZSTD_createDStream()) {
+    ok_ = stream_ != nullptr && !ZSTD_isError(ZSTD_initDStream(stream_));
+  }
+  ~ZstdDecoder() { ZSTD_freeDStream(stream_); }
+  ZstdDecoder(const ZstdDecoder&) = delete;
+  ZstdDecoder& operator=(const ZstdDecoder&) = delete;
+
+  bool ok() const { return ok_; }
+
+  Step step(const uint8_t* in, size_t in_size, uint8_t* out, size_t out_size) {
+    ZSTD_inBuffer input{in, in_size, 0};
+    ZSTD_outBuffer output{out, out_size, 0};
+    const size_t rc = ZSTD_decompressStream(stream_, &output, &input);
+    Step step;
+    step.consumed = input.pos;
+    step.produced = output.pos;
+    if (ZSTD_isError(rc)) {
+      step.error = std::string("zstd error: ") + ZSTD_getErrorName(rc);
+    } else if (rc == 0) {
+      step.end_of_stream = true;
+    }
+    return step;
+  }
+
+  bool restart(const uint8_t*, size_t in_size) { return in_size > 0; }
+
+ private:
+  ZSTD_DStream* stream_ = nullptr;
+  bool ok_ = false;
+};
+
 ChunkDecompression result(ChunkDecompression::Status status, size_t size, std::string problem) {
   ChunkDecompression out;
   out.status = status;
@@ -179,6 +214,8 @@ std::string to_string(ChunkCompression compression) {
       return "bz2";
     case ChunkCompression::kLz4:
       return "lz4";
+    case ChunkCompression::kZstd:
+      return "zstd";
   }
   return "unknown";
 }
@@ -207,6 +244,10 @@ ChunkDecompression decompress_chunk(ChunkCompression compression, ByteView input
     }
     case ChunkCompression::kLz4: {
       Lz4FrameDecoder decoder;
+      return run_decoder(decoder, input, declared_size, output);
+    }
+    case ChunkCompression::kZstd: {
+      ZstdDecoder decoder;
       return run_decoder(decoder, input, declared_size, output);
     }
   }

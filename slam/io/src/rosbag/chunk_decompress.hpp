@@ -1,6 +1,7 @@
 #pragma once
-/// Decompression of bag chunks: `none`, `bz2` (one or more bzip2 streams) and `lz4` (the
-/// LZ4 frame format, as ROS's roslz4 writes it).
+/// Decompression of bag and MCAP chunks: `none`, `bz2` (one or more bzip2 streams), `lz4`
+/// (the LZ4 frame format, as ROS's roslz4 and MCAP writers write it) and `zstd` (one or
+/// more Zstandard frames; MCAP only).
 
 #include <cstddef>
 #include <cstdint>
@@ -13,9 +14,10 @@
 
 namespace featsense::slam {
 
-enum class ChunkCompression { kNone, kBz2, kLz4 };
+enum class ChunkCompression { kNone, kBz2, kLz4, kZstd };
 
-/// The compression named by a chunk's `compression` field, or nullopt if unknown.
+/// The compression named by a ROS1 bag chunk's `compression` field (none, bz2, lz4), or
+/// nullopt if unknown.
 std::optional<ChunkCompression> parse_chunk_compression(std::string_view name);
 std::string to_string(ChunkCompression compression);
 

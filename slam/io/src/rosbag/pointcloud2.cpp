@@ -40,24 +40,7 @@ PointCloud2View parse_pointcloud2(ByteView message) {
   cloud.seq = in.u32("header.seq");
   cloud.stamp_ns = in.time_ns("header.stamp");
   cloud.frame_id = in.string("header.frame_id");
-  cloud.height = in.u32("height");
-  cloud.width = in.u32("width");
-  const uint32_t field_count = in.u32("fields count");
-  // No reserve(field_count): the count is unchecked, and each field needs at least 13 bytes,
-  // so a lying count ends in a SerializationError after as many fields as the data holds.
-  for (uint32_t i = 0; i < field_count; ++i) {
-    PointFieldDesc field;
-    field.name = in.string("field name");
-    field.offset = in.u32("field offset");
-    field.datatype = in.u8("field datatype");
-    field.count = in.u32("field count");
-    cloud.fields.push_back(std::move(field));
-  }
-  cloud.is_bigendian = in.u8("is_bigendian") != 0;
-  cloud.point_step = in.u32("point_step");
-  cloud.row_step = in.u32("row_step");
-  cloud.data = in.byte_array("data");
-  cloud.is_dense = in.u8("is_dense") != 0;
+  read_pointcloud2_body(in, cloud);
   return cloud;
 }
 

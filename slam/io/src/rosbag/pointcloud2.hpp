@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rosbag/ros_serialization.hpp"
@@ -70,5 +71,29 @@ constexpr size_t kMaxCloudPoints = size_t{1} << 24;
 /// no x/y/z, a field past point_step or of an unknown datatype, row_step or data too short
 /// for width x height points. Once it returns "", every point's fields lie inside `data`.
 std::string layout_problem(const PointCloud2View& cloud);
+
+/// The fields after the header, the same in ROS 1 and in CDR: `In` is RosDeserializer or
+/// CdrDeserializer (which aligns them). Throws SerializationError.
+template <typename In>
+void read_pointcloud2_body(In& in, PointCloud2View& cloud) {
+  cloud.height = in.u32("height");
+  cloud.width = in.u32("width");
+  const uint32_t field_count = in.u32("fields count");
+  // No reserve(field_count): the count is unchecked, and each field needs at least 13 bytes,
+  // so a lying count ends in a SerializationError after as many fields as the data holds.
+  for (uint32_t i = 0; i < field_count; ++i) {
+    PointFieldDesc field;
+    field.name = in.string("field name");
+    field.offset = in.u32("field offset");
+    field.datatype = in.u8("field datatype");
+    field.count = in.u32("field count");
+    cloud.fields.push_back(std::move(field));
+  }
+  cloud.is_bigendian = in.u8("is_bigendian") != 0;
+  cloud.point_step = in.u32("point_step");
+  cloud.row_step = in.u32("row_step");
+  cloud.data = in.bytes(in.u32("data count"), "data");
+  cloud.is_dense = in.u8("is_dense") != 0;
+}
 
 }  // namespace featsense::slam

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "featsense/slam/io/azimuth_times.hpp"
+#include "ros2/cdr_pointcloud2.hpp"
 #include "rosbag/cloud_sensor_model.hpp"
 #include "rosbag/pointcloud2.hpp"
 #include "rosbag/pointcloud2_convert.hpp"
@@ -13,6 +14,11 @@ namespace {
 std::string describe_message(uint64_t index, const BagMessage& message) {
   return "message " + std::to_string(index) + " (record at offset " +
          std::to_string(message.offset) + ")";
+}
+
+/// A PointCloud2 message of either encoding.
+PointCloud2View parse_cloud(ByteView data, MessageEncoding encoding) {
+  return encoding == MessageEncoding::kCdr ? parse_pointcloud2_cdr(data) : parse_pointcloud2(data);
 }
 
 /// Per-point times from the azimuth (azimuth_times.hpp) of a cloud's points in the order
@@ -34,23 +40,14 @@ struct FirstCloud {
 };
 
 FirstCloud read_first_cloud(const BagTopicContext& context) {
-  BagReadOptions options;
-  options.wanted = [&context](const BagMessage&, const BagConnection* connection) {
-    return connection != nullptr && connection->topic == context.topic.name;
-  };
   std::string first_problem;
-  options.warn = [&first_problem](const std::string& message) {
-    if (first_problem.empty()) first_problem = message;
-  };
-  BagRecordReader reader(context.stream, context.origin, options);
-  for (const auto& [id, connection] : context.catalog.connections) {
-    reader.add_connection(connection);
-  }
+  std::unique_ptr<MessageCursor> messages = context.open_topic(context.topic);
+  const MessageEncoding encoding = context.topic.encoding;
   uint64_t index = 0;
-  while (const std::optional<BagMessage> message = reader.next()) {
+  while (const std::optional<BagMessage> message = messages->next()) {
     std::string problem;
     try {
-      const PointCloud2View cloud = parse_pointcloud2(message->data);
+      const PointCloud2View cloud = parse_cloud(message->data, encoding);
       problem = layout_problem(cloud);
       if (problem.empty()) {
         FirstCloud first;
@@ -118,17 +115,18 @@ config::SensorModel choose_sensor(const BagTopicContext& context, const FirstClo
 }  // namespace
 
 PointCloud2Decoder::PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize,
-                                       bool times_from_azimuth)
+                                       bool times_from_azimuth, MessageEncoding encoding)
     : sensor_(std::move(sensor)),
       organize_(std::move(organize)),
-      times_from_azimuth_(times_from_azimuth) {}
+      times_from_azimuth_(times_from_azimuth),
+      encoding_(encoding) {}
 
 std::optional<Scan> PointCloud2Decoder::decode(const BagMessage& message,
                                                const DecodeReport& report) {
   const uint64_t index = message_index_++;
   PointCloud2View cloud;
   try {
-    cloud = parse_pointcloud2(message.data);
+    cloud = parse_cloud(message.data, encoding_);
   } catch (const SerializationError& e) {
     report.skip_frame(describe_message(index, message) + ": PointCloud2 " + e.what());
     return std::nullopt;
@@ -187,7 +185,8 @@ std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& 
   } else {
     info.times = describe_times(first.time_field, nullptr);
   }
-  return std::make_unique<PointCloud2Decoder>(std::move(sensor), std::move(organize), from_azimuth);
+  return std::make_unique<PointCloud2Decoder>(std::move(sensor), std::move(organize), from_azimuth,
+                                              context.topic.encoding);
 }
 
 }  // namespace featsense::slam

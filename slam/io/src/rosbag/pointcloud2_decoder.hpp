@@ -24,8 +24,10 @@ class PointCloud2Decoder final : public BagScanDecoder {
   /// `sensor` is the model unorganized clouds are organized for. Clouds without a time
   /// field get per-point times from the azimuth when `times_from_azimuth`
   /// (sensor.times_from_azimuth), counted from the message's stamp, the sweep's start.
+  /// `encoding`: ROS 1 messages or ROS 2's CDR.
   PointCloud2Decoder(config::SensorModel sensor, CloudOrganizer organize,
-                     bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth);
+                     bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth,
+                     MessageEncoding encoding = MessageEncoding::kRos1);
 
   /// Scan rows: row 0 the highest beam. An organized cloud stored lowest beam first is
   /// flipped; which way the topic's clouds run is decided on the first cloud that tells it,
@@ -37,6 +39,7 @@ class PointCloud2Decoder final : public BagScanDecoder {
   config::SensorModel sensor_;
   CloudOrganizer organize_;
   bool times_from_azimuth_;
+  MessageEncoding encoding_;
   std::optional<bool> lowest_first_;
   uint64_t message_index_ = 0;
 };

@@ -44,6 +44,7 @@ class RosDeserializer {
   explicit RosDeserializer(ByteView bytes) : bytes_(bytes) {}
 
   uint8_t u8(const char* what) { return load_le<uint8_t>(take(1, what)); }
+  uint16_t u16(const char* what) { return load_le<uint16_t>(take(2, what)); }
   uint32_t u32(const char* what) { return load_le<uint32_t>(take(4, what)); }
   uint64_t u64(const char* what) { return load_le<uint64_t>(take(8, what)); }
   /// A ROS time (u32 sec, u32 nsec) as nanoseconds since the epoch.

@@ -10,6 +10,7 @@
 #include "rosbag/bag_catalog.hpp"
 #include "rosbag/bag_topic_choice.hpp"
 #include "rosbag/ros_serialization.hpp"
+#include "rosbag/simple_messages.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -26,14 +27,15 @@ std::string read_text_file(const std::string& path) {
 /// complete.
 class OusterPacketDecoder final : public BagScanDecoder {
  public:
-  explicit OusterPacketDecoder(OusterMetadata metadata)
-      : packet_size_(metadata.packet_size()), assembler_(std::move(metadata)) {}
+  OusterPacketDecoder(OusterMetadata metadata, MessageEncoding encoding)
+      : packet_size_(metadata.packet_size()),
+        assembler_(std::move(metadata)),
+        encoding_(encoding) {}
 
   std::optional<Scan> decode(const BagMessage& message, const DecodeReport& report) override {
     ByteView payload;
     try {
-      RosDeserializer in(message.data);
-      payload = in.byte_array("PacketMsg buf");
+      payload = byte_array_message(message.data, encoding_);
     } catch (const SerializationError& e) {
       report.warn("packet at offset " + std::to_string(message.offset) + ": " + e.what());
       return std::nullopt;
@@ -71,6 +73,7 @@ class OusterPacketDecoder final : public BagScanDecoder {
 
   size_t packet_size_;
   OusterFrameAssembler assembler_;
+  MessageEncoding encoding_;
   uint64_t next_sequence_ = 0;
   size_t incomplete_reported_ = 0;
 };
@@ -92,8 +95,7 @@ std::unique_ptr<BagScanDecoder> make_ouster_packet_decoder(const BagTopicContext
     json_origin = *context.options.meta_path;
     json = read_text_file(json_origin);
   } else if (const BagTopic* topic = metadata_topic_for(context.catalog, context.topic)) {
-    std::optional<std::string> text =
-        read_first_string_message(context.stream, context.origin, context.catalog, *topic);
+    std::optional<std::string> text = first_string_message(context.open_topic, *topic);
     if (!text) {
       throw InputError(context.origin + ": the metadata topic " + topic->name +
                        " holds no readable message; pass the sensor's metadata JSON (--meta)");
@@ -112,7 +114,7 @@ std::unique_ptr<BagScanDecoder> make_ouster_packet_decoder(const BagTopicContext
   info.detail = metadata.prod_line + " " + metadata.lidar_mode + ", profile " +
                 to_string(metadata.profile) + ", metadata from " + json_origin;
   info.times = "per column, from the lidar packets' timestamps";
-  return std::make_unique<OusterPacketDecoder>(std::move(metadata));
+  return std::make_unique<OusterPacketDecoder>(std::move(metadata), context.topic.encoding);
 }
 
 }  // namespace featsense::slam

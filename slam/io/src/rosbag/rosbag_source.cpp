@@ -5,70 +5,65 @@
 
 #include "rosbag/bag_catalog.hpp"
 #include "rosbag/bag_record_reader.hpp"
-#include "rosbag/bag_topic_choice.hpp"
 
 namespace featsense::slam {
 namespace {
 
-class RosbagSource final : public ScanSource {
+/// The messages of one topic (by name: a topic may have several connections), read with a
+/// record reader of its own over a stream of its own.
+class RosbagTopicCursor final : public MessageCursor {
  public:
-  RosbagSource(SourceInfo info, const BagCatalog& catalog, const BagTopic& topic,
-               std::unique_ptr<BagScanDecoder> decoder)
-      : info_(std::move(info)),
-        topic_(topic.name),
-        stream_(info_.path, std::ios::binary),
-        reader_(stream_, info_.path, read_options()),
-        decoder_(std::move(decoder)) {
+  RosbagTopicCursor(const std::string& path, const BagCatalog& catalog, std::string topic,
+                    WarningSink warn)
+      : topic_(std::move(topic)),
+        stream_(path, std::ios::binary),
+        reader_(stream_, path, read_options(std::move(warn))) {
     for (const auto& [id, connection] : catalog.connections) reader_.add_connection(connection);
-    report_.warn = [this](const std::string& message) { warn(message); };
-    report_.skip_frame = [this](const std::string& message) { skip_frame(message); };
   }
 
-  std::optional<Scan> next() override {
-    while (!done_) {
-      std::optional<Scan> scan;
-      if (std::optional<BagMessage> message = reader_.next()) {
-        scan = decoder_->decode(*message, report_);
-      } else {
-        done_ = true;
-        scan = decoder_->finish(report_);
-      }
-      if (scan) {
-        count_frame();
-        return scan;
-      }
-    }
-    return std::nullopt;
-  }
-
-  const SourceInfo& info() const override { return info_; }
+  std::optional<BagMessage> next() override { return reader_.next(); }
 
  private:
-  /// Messages of the chosen topic only (by name: a topic may have several connections);
-  /// damage the reader meets becomes a counted warning of this source.
-  BagReadOptions read_options() {
+  BagReadOptions read_options(WarningSink warn) {
     BagReadOptions options;
     options.wanted = [this](const BagMessage&, const BagConnection* connection) {
       return connection != nullptr && connection->topic == topic_;
     };
-    options.warn = [this](const std::string& message) { warn(message); };
+    options.warn = std::move(warn);
     return options;
   }
 
-  SourceInfo info_;
   std::string topic_;
   std::ifstream stream_;
   BagRecordReader reader_;  // reads stream_, so it comes after it
-  std::unique_ptr<BagScanDecoder> decoder_;
-  DecodeReport report_;
-  bool done_ = false;
 };
 
-std::string join(const std::vector<std::string>& parts, const char* separator) {
-  std::string out;
-  for (const std::string& part : parts) out += (out.empty() ? "" : separator) + part;
-  return out;
-}
+class RosbagLog final : public MessageLog {
+ public:
+  RosbagLog(std::string path, BagCatalog catalog)
+      : path_(std::move(path)), catalog_(std::move(catalog)) {}
+
+  const BagCatalog& catalog() const override { return catalog_; }
+
+  std::unique_ptr<MessageCursor> open(const BagTopic& topic, WarningSink warn) override {
+    return std::make_unique<RosbagTopicCursor>(path_, catalog_, topic.name, std::move(warn));
+  }
+
+  std::string describe() const override {
+    std::string compressions;
+    for (const std::string& name : catalog_.compressions) {
+      compressions += (compressions.empty() ? "" : "+") + name;
+    }
+    std::string text = std::to_string(catalog_.connections.size()) + " connections, " +
+                       (compressions.empty() ? std::string("no chunks") : compressions);
+    if (!catalog_.from_index) text += ", no usable index (chunks walked)";
+    return text;
+  }
+
+ private:
+  std::string path_;
+  BagCatalog catalog_;
+};
 
 }  // namespace
 
@@ -77,29 +72,12 @@ std::unique_ptr<ScanSource> open_rosbag_source(const std::string& path,
                                                const RosbagDependencies& dependencies) {
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(path + ": cannot open");
-  const BagCatalog catalog = catalog_bag(stream, path);
-  const BagTopic& topic = choose_scan_topic(catalog, options.topic, path);
-
+  BagCatalog catalog = catalog_bag(stream, path);
   SourceInfo info;
   info.format = "rosbag";
   info.path = path;
-  const BagTopicContext context{stream, path, catalog, topic, options};
-  std::unique_ptr<BagScanDecoder> decoder;
-  if (classify_topic(topic) == BagTopicKind::kPointCloud2) {
-    decoder =
-        make_pointcloud2_decoder(context, dependencies.organize, dependencies.sensor_for, info);
-  } else {
-    decoder = dependencies.ouster_packets(context, info);
-  }
-
-  std::string detail =
-      "topic " + topic.name + " (" + topic.type + "), " +
-      std::to_string(catalog.connections.size()) + " connections, " +
-      (catalog.compressions.empty() ? std::string("no chunks") : join(catalog.compressions, "+"));
-  if (!catalog.from_index) detail += ", no usable index (chunks walked)";
-  if (!info.detail.empty()) detail += "; " + info.detail;
-  info.detail = detail;
-  return std::make_unique<RosbagSource>(std::move(info), catalog, topic, std::move(decoder));
+  return open_message_log_source(std::make_unique<RosbagLog>(path, std::move(catalog)),
+                                 std::move(info), options, dependencies);
 }
 
 }  // namespace featsense::slam

@@ -32,6 +32,8 @@ struct SourceInfo {
   /// Where the per-point times come from, one line for humans: "per-point field 't'",
   /// "from the azimuth (...)", "none: why"; as the first frame had them.
   std::string times;
+  /// Recordings of several topics (bags, MCAP): each as "name (type, encoding, N messages)".
+  std::vector<std::string> topics;
 };
 
 /// Counts of what a source skipped; warnings are counted, the first few kept verbatim.

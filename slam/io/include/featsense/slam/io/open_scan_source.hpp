@@ -19,6 +19,12 @@ struct SourceOptions {
   /// Config key sensor.times_from_azimuth: clouds without a time field get per-point times
   /// from their points' azimuths (azimuth_times.hpp).
   bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth;
+  /// Config key sensor.calibration: a Velodyne calibration YAML (else the model's built-in
+  /// laser table).
+  std::optional<std::string> velodyne_calibration;
+  /// Config key sensor.scan_cut_deg: the azimuth (degrees clockwise from +x) where packet
+  /// streams (Velodyne) are cut into scans.
+  double scan_cut_deg = config::SensorConfig{}.scan_cut_deg;
 };
 
 /// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the
@@ -27,7 +33,8 @@ std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source
                                               double max_m);
 
 /// Opens a recording, detecting its format from the content: an Ouster pcap, a ROS1 bag, a
-/// PCD or PLY file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense simulate`.
+/// ROS 2 bag (a folder holding metadata.yaml, or one .db3), an MCAP file, a PCD or PLY
+/// file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense simulate`.
 /// Returned scans already have the range limits applied. Throws InputError.
 std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
                                              const SourceOptions& options = {});

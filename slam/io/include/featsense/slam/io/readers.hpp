@@ -16,8 +16,22 @@ namespace featsense::slam {
 /// packet, or cut before the first) throws InputError from next(), naming the sizes it saw; a
 /// capture cut later ends with a counted warning after the frames before the cut.
 std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path, const SourceOptions& options);
-/// A ROS1 bag (format 2.0): sensor_msgs/PointCloud2 or raw ouster_ros/PacketMsg topics.
+/// A Velodyne pcap (VeloView or tcpdump): the 1206-byte UDP data packets of a VLP-16,
+/// VLP-32C, HDL-32E, HDL-64E or VLS-128, decoded with sensor.calibration (else the model's
+/// built-in table) and cut into scans at sensor.scan_cut_deg.
+std::unique_ptr<ScanSource> open_velodyne_pcap(const std::string& path,
+                                               const SourceOptions& options);
+/// True where the first UDP datagrams of a pcap include a Velodyne data packet.
+bool is_velodyne_pcap(const std::string& path);
+/// A ROS1 bag (format 2.0): sensor_msgs/PointCloud2, velodyne_msgs/VelodyneScan or raw
+/// ouster_ros/PacketMsg topics.
 std::unique_ptr<ScanSource> open_rosbag(const std::string& path, const SourceOptions& options);
+/// A ROS 2 bag: its folder (metadata.yaml + .db3 or .mcap files, read in the order the
+/// metadata lists them) or one .db3 file. Topics as in open_rosbag(), serialized as CDR.
+std::unique_ptr<ScanSource> open_ros2_bag(const std::string& path, const SourceOptions& options);
+/// An MCAP file (chunks uncompressed, zstd or lz4; with or without a summary) of ROS 2 (CDR)
+/// or ROS 1 messages; topics as in open_rosbag().
+std::unique_ptr<ScanSource> open_mcap(const std::string& path, const SourceOptions& options);
 /// One PCD file (one frame).
 std::unique_ptr<ScanSource> open_pcd_file(const std::string& path, const SourceOptions& options);
 /// One PLY point cloud (one frame).

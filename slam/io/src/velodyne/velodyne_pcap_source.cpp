@@ -1,0 +1,98 @@
+// A Velodyne recording in a pcap file (as VeloView and tcpdump capture it): the UDP data
+// packets of 1206 bytes (port 2368 by default; position packets of 512 bytes on 8308 and
+// anything else are passed over), read as a stream of scans.
+
+#include <fstream>
+#include <vector>
+
+#include "featsense/slam/io/readers.hpp"
+#include "ouster/pcap_udp_reader.hpp"
+#include "velodyne/velodyne_setup.hpp"
+
+namespace featsense::slam {
+namespace {
+
+/// UDP datagrams looked at to tell a Velodyne capture from an Ouster one.
+constexpr size_t kProbeDatagrams = 64;
+
+class VelodynePcapSource final : public ScanSource {
+ public:
+  VelodynePcapSource(const std::string& path, const VelodyneSetup& setup)
+      : stream_(path, std::ios::binary),
+        reader_(stream_, path),
+        assembler_(make_velodyne_assembler(setup)) {
+    info_.format = "velodyne-pcap";
+    info_.path = path;
+    info_.sensor = setup.sensor;
+    info_.sensor_from_metadata = true;
+    info_.fields = velodyne_fields();
+    info_.detail = setup.detail;
+    info_.times = "per point, from the firing timing of the packets";
+  }
+
+  std::optional<Scan> next() override {
+    for (;;) {
+      if (std::optional<Scan> scan = assembler_.take()) {
+        count_frame();
+        return scan;
+      }
+      if (done_) return std::nullopt;
+      const std::optional<detail::UdpDatagram> datagram = reader_.next();
+      if (!datagram) {
+        done_ = true;
+        if (reader_.problem()) warn(*reader_.problem());
+        if (assembler_.decoder().bad_blocks() > 0) {
+          warn(std::to_string(assembler_.decoder().bad_blocks()) +
+               " Velodyne data blocks with a flag or azimuth the model does not use; skipped");
+        }
+        assembler_.flush();
+        continue;
+      }
+      if (datagram->size != kVelodynePacketBytes) continue;
+      assembler_.add_packet(datagram->payload, datagram->timestamp_ns);
+    }
+  }
+
+  const SourceInfo& info() const override { return info_; }
+
+ private:
+  SourceInfo info_;
+  std::ifstream stream_;
+  detail::PcapUdpReader reader_;  // reads stream_, so it comes after it
+  VelodyneScanAssembler assembler_;
+  bool done_ = false;
+};
+
+/// The first Velodyne data packet among the first datagrams, if any.
+std::optional<std::vector<uint8_t>> first_velodyne_packet(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  detail::PcapUdpReader reader(stream, path);
+  for (size_t i = 0; i < kProbeDatagrams; ++i) {
+    const std::optional<detail::UdpDatagram> datagram = reader.next();
+    if (!datagram) break;
+    if (datagram->size == kVelodynePacketBytes) {
+      return std::vector<uint8_t>(datagram->payload, datagram->payload + datagram->size);
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool is_velodyne_pcap(const std::string& path) {
+  try {
+    return first_velodyne_packet(path).has_value();
+  } catch (const InputError&) {
+    return false;  // the Ouster reader names what is wrong with the file
+  }
+}
+
+std::unique_ptr<ScanSource> open_velodyne_pcap(const std::string& path,
+                                               const SourceOptions& options) {
+  const std::optional<std::vector<uint8_t>> first = first_velodyne_packet(path);
+  if (!first) throw InputError(path + ": no Velodyne data packet (1206-byte UDP payload)");
+  return std::make_unique<VelodynePcapSource>(
+      path, velodyne_setup(first->data(), options, sensor_for, path));
+}
+
+}  // namespace featsense::slam
