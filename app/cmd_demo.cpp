@@ -2,6 +2,7 @@
 // (or the true ones, --gt-poses), meshed and compared with the truth, in one command that
 // needs nothing but the program.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -49,6 +50,19 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
         "  poses estimated by the odometry: ATE %.1f mm (RMSE over %d poses, %.1f m of path)\n",
         1e3 * t["ape"]["rmse"].get<double>(), t["ape"]["count"].get<int>(),
         t["ground_truth_length_m"].get<double>());
+    if (r.contains("loops") && r["loops"].value("accepted", 0) > 0) {
+      const nlohmann::json& loops = r["loops"];
+      std::string before;
+      if (r["eval"].contains("traj_before_loops")) {
+        before = ": ATE before them " +
+                 std::to_string(std::lround(
+                     1e3 * r["eval"]["traj_before_loops"]["ape"]["rmse"].get<double>())) +
+                 " mm; " + loops["second_pass"].get<std::string>();
+      }
+      std::printf("  %d loops closed (%d keyframes, %d candidates rejected)%s\n",
+                  loops["accepted"].get<int>(), loops["keyframes"].get<int>(),
+                  loops["candidates"].get<int>() - loops["accepted"].get<int>(), before.c_str());
+    }
   } else {
     std::printf("  mapped with the true poses\n");
   }
