@@ -14,8 +14,8 @@
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
-#include "featsense/slam/odometry/feature_odometry.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/odometry/feature_odometry.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/refine/refinement_cloud.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
@@ -313,7 +313,8 @@ class BenchLoops {
     for (const slam::loops::PoseGraphEdge& edge : closer_.graph().edges()) {
       if (!edge.loop) continue;
       ++k;
-      const std::optional<Eigen::Isometry3d> from = truth_at(*truth, keyframe_stamps_ns_[edge.from]);
+      const std::optional<Eigen::Isometry3d> from =
+          truth_at(*truth, keyframe_stamps_ns_[edge.from]);
       const std::optional<Eigen::Isometry3d> to = truth_at(*truth, keyframe_stamps_ns_[edge.to]);
       if (!from || !to) continue;
       const Eigen::Isometry3d error = (from->inverse() * *to).inverse() * edge.T_from_to;
