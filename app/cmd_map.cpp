@@ -194,23 +194,32 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       // first map only once it is complete.
       spdlog::info("{} loops closed: mapping the recording again with the corrected poses",
                    loops->loops.size());
-      const std::unique_ptr<slam::ScanSource> again = reopen();
-      const std::unique_ptr<slam::ScanLocator> corrected =
-          slam::make_given_pose_locator(loops->corrected, config.odometry.deskew);
-      PipelineSettings replay = pipeline;
-      replay.refine.reset();
-      replay.loops.reset();
       const fs::path replay_path = out / "map.corrected.h5";
-      MapPassOutput replayed = run_map_pass(*again, *corrected, replay, config,
-                                            {replay_path, info.sensor.name, std::nullopt, true});
-      if (replayed.result.interrupted) {
+      std::optional<MapPassOutput> replayed;
+      try {
+        const std::unique_ptr<slam::ScanSource> again = reopen();
+        const std::unique_ptr<slam::ScanLocator> corrected =
+            slam::make_given_pose_locator(loops->corrected, config.odometry.deskew);
+        PipelineSettings replay = pipeline;
+        replay.refine.reset();
+        replay.loops.reset();
+        replayed = run_map_pass(*again, *corrected, replay, config,
+                                {replay_path, info.sensor.name, std::nullopt, true});
+      } catch (const std::exception& e) {
+        // The input changed or went away since the first pass: its map stays.
+        spdlog::warn("the second pass failed: {}; the map keeps the odometry's poses", e.what());
+        second_pass = std::string("failed (") + e.what() + "): the map keeps the odometry's poses";
+        std::error_code ignored;
+        fs::remove(replay_path, ignored);
+      }
+      if (replayed && replayed->result.interrupted) {
         fs::remove(replay_path);
         second_pass = "interrupted: the map keeps the odometry's poses";
         pass.result.interrupted = true;
-      } else {
+      } else if (replayed) {
         fs::rename(replay_path, out / "map.h5");
         second_pass = "mapped again with the corrected poses";
-        pass = std::move(replayed);
+        pass = std::move(*replayed);
         second = pass.result;
       }
     }
