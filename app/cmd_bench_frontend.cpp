@@ -22,6 +22,7 @@
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
+#include "loop_stage.hpp"
 #include "map_report.hpp"
 #include "simulate_job.hpp"
 #include "source_options.hpp"
@@ -274,11 +275,7 @@ class BenchLoops {
   /// The corrected poses of every scan added.
   slam::Trajectory finish() {
     if (!closer_.loops().empty()) closer_.optimise();
-    const slam::loops::TrajectoryCorrection correction = closer_.correction();
-    slam::Trajectory corrected;
-    for (size_t i = 0; i < path_.size(); ++i)
-      corrected.push_back(path_.stamps_ns[i], correction.apply(travelled_m_[i], path_.poses[i]));
-    return corrected;
+    return corrected_path(closer_.correction(), path_, travelled_m_);
   }
 
   /// Counts and times; with the truth, each loop's measured pose against it: a loop more than

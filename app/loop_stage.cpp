@@ -14,6 +14,15 @@ constexpr size_t kKeyframesQueued = 8;
 
 }  // namespace
 
+slam::Trajectory corrected_path(const slam::loops::TrajectoryCorrection& correction,
+                                const slam::Trajectory& path,
+                                const std::vector<double>& travelled_m) {
+  slam::Trajectory out;
+  for (size_t i = 0; i < path.size(); ++i)
+    out.push_back(path.stamps_ns[i], correction.apply(travelled_m[i], path.poses[i]));
+  return out;
+}
+
 LoopStage::LoopStage(const slam::loops::LoopSettings& settings)
     : settings_(settings),
       selector_(settings.keyframe_distance_m, settings.keyframe_angle_deg),
@@ -65,12 +74,11 @@ LoopOutcome LoopStage::finish() {
   out.counts = closer_.counts();
   out.keyframe_queue_wait_ms = wait_ms_;
   out.before = path_;
-  const slam::loops::TrajectoryCorrection correction = closer_.correction();
+  out.corrected = corrected_path(closer_.correction(), path_, travelled_m_);
   for (size_t i = 0; i < path_.size(); ++i) {
-    const Eigen::Isometry3d corrected = correction.apply(travelled_m_[i], path_.poses[i]);
-    out.corrections_max_m = std::max(
-        out.corrections_max_m, (corrected.translation() - path_.poses[i].translation()).norm());
-    out.corrected.push_back(path_.stamps_ns[i], corrected);
+    out.corrections_max_m =
+        std::max(out.corrections_max_m,
+                 (out.corrected.poses[i].translation() - path_.poses[i].translation()).norm());
   }
   return out;
 }

@@ -29,6 +29,12 @@ struct LoopOutcome {
   double keyframe_queue_wait_ms = 0.0;  ///< the pipeline's wait for the loop thread, in all
 };
 
+/// Every pose of `path` (pose i taken `travelled_m[i]` metres along it) moved by the
+/// keyframes' corrections around it.
+slam::Trajectory corrected_path(const slam::loops::TrajectoryCorrection& correction,
+                                const slam::Trajectory& path,
+                                const std::vector<double>& travelled_m);
+
 class LoopStage {
  public:
   explicit LoopStage(const slam::loops::LoopSettings& settings);
