@@ -41,6 +41,9 @@ struct BenchFrontEndOptions {
   bool refine = false;          ///< bench odometry: the map refinement too (refine.*)
   std::string refined_out;      ///< bench odometry --refine: the refined poses, TUM
   bool loops = false;           ///< bench odometry: loop closure over the final poses (loop.*)
+  std::string corrected_out;    ///< bench odometry --loops: the corrected poses, TUM
+  std::string truth_out;        ///< bench odometry: the simulated truth, TUM
+  bool wrong_loop = false;      ///< bench odometry --loops: a wrong loop injected at the end
   InputOptions input;
   int scans = 100;
   std::optional<std::string> json_path;
@@ -278,6 +281,45 @@ class BenchLoops {
     return corrected_path(closer_.correction(), path_, travelled_m_);
   }
 
+  /// The corrected poses of every scan added, from the graph as it is.
+  slam::Trajectory corrected() const {
+    return corrected_path(closer_.correction(), path_, travelled_m_);
+  }
+
+  /// A deliberately wrong loop added to the graph (and optimised): the keyframe three
+  /// quarters along the path claimed to lie 4 m ahead of the one a quarter along and turned
+  /// 30 degrees, as confident as the first true loop. What the claim is off by against the
+  /// truth, and the weight the robust loss left it.
+  nlohmann::json inject_wrong_loop(const std::optional<slam::Trajectory>& truth) {
+    const size_t n = closer_.keyframes();
+    if (n < 8) return {{"skipped", "fewer than 8 keyframes"}};
+    const size_t from = n / 4, to = 3 * n / 4;
+    Eigen::Isometry3d claim = Eigen::Isometry3d::Identity();
+    claim.linear() =
+        Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    claim.translation() = Eigen::Vector3d(4.0, 0.0, 0.0);
+    slam::loops::Matrix6d information = slam::loops::Matrix6d::Identity();
+    information.diagonal() << 1e4, 1e4, 1e4, 400.0, 400.0, 400.0;  // 0.01 rad, 5 cm
+    for (const slam::loops::PoseGraphEdge& edge : closer_.graph().edges()) {
+      if (edge.loop) {
+        information = edge.information;
+        break;
+      }
+    }
+    closer_.add_loop_edge(from, to, claim, information);
+    nlohmann::json out = {{"from", from}, {"to", to}, {"weight", closer_.loops().back().weight}};
+    const std::optional<Eigen::Isometry3d> a =
+        truth ? truth_at(*truth, keyframe_stamps_ns_[from]) : std::nullopt;
+    const std::optional<Eigen::Isometry3d> b =
+        truth ? truth_at(*truth, keyframe_stamps_ns_[to]) : std::nullopt;
+    if (a && b) {
+      const Eigen::Isometry3d error = (a->inverse() * *b).inverse() * claim;
+      out["claim_error_m"] = error.translation().norm();
+      out["claim_error_deg"] = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
+    }
+    return out;
+  }
+
   /// Counts and times; with the truth, each loop's measured pose against it: a loop more than
   /// 0.3 m or 2 degrees off is false (it would bend the map).
   nlohmann::json json(const std::optional<slam::Trajectory>& truth) const {
@@ -449,6 +491,8 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   result["peak_rss_mb"] = peak_rss_mb();
   if (!options.estimate_out.empty()) slam::write_tum(estimate, options.estimate_out);
   if (scans.truth()) add_trajectory_error(estimate, *scans.truth(), result);
+  if (scans.truth() && !options.truth_out.empty())
+    slam::write_tum(*scans.truth(), options.truth_out);
   if (refinement) {
     const std::vector<slam::ScanPlacement> final = refinement->finish();
     if (loops) to_loops(final);
@@ -460,8 +504,19 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
   }
   if (loops) {
     const slam::Trajectory corrected = loops->finish();
+    if (!options.corrected_out.empty()) slam::write_tum(corrected, options.corrected_out);
     nlohmann::json closed = loops->json(scans.truth());
     if (scans.truth()) add_trajectory_error(corrected, *scans.truth(), closed);
+    if (options.wrong_loop) {
+      nlohmann::json wrong = loops->inject_wrong_loop(scans.truth());
+      if (scans.truth() && !wrong.contains("skipped")) {
+        add_trajectory_error(loops->corrected(), *scans.truth(), wrong);
+        if (closed.contains("ape_rmse_m") && wrong.contains("ape_rmse_m"))
+          wrong["ape_ratio"] = wrong["ape_rmse_m"].get<double>() /
+                               std::max(closed["ape_rmse_m"].get<double>(), 1e-12);
+      }
+      closed["wrong_loop"] = wrong;
+    }
     result["loops"] = closed;
   }
   return result;
@@ -496,6 +551,13 @@ Command add_front_end_bench(CLI::App& bench, const char* name, const char* help,
                       "Refine the poses too (refine.*): its ms, and the refined poses' error");
     command->add_option("--refined-out", options->refined_out,
                         "With --refine: write the refined poses here (TUM)");
+    command->add_option("--corrected-out", options->corrected_out,
+                        "With --loops: write the loop-corrected poses here (TUM)");
+    command->add_option("--truth-out", options->truth_out,
+                        "Write the simulated truth at the scans' stamps here (TUM)");
+    command->add_flag("--wrong-loop", options->wrong_loop,
+                      "With --loops: then add a deliberately wrong loop to the graph and give "
+                      "the error of the poses with it (the robust loss at work)");
     command->add_flag("--loops", options->loops,
                       "Close loops over the final poses (loop.*): ms per keyframe, the loops, "
                       "false ones against the truth, the corrected poses' error");
