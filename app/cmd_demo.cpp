@@ -73,6 +73,12 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
         "within 5 cm and %s within 10 cm of what the sensor saw\n",
         1e3 * e["accuracy"]["mean_abs"].get<double>(), 1e3 * e["accuracy"]["median"].get<double>(),
         percent(e["completeness"]["0.05"]).c_str(), percent(e["completeness"]["0.10"]).c_str());
+    if (e.contains("aligned")) {
+      const nlohmann::json& a = e["aligned"]["accuracy"];
+      std::printf(
+          "  aligned with the true path first (the map's own shape): mean %.1f mm, p95 %.1f mm\n",
+          1e3 * a["mean_abs"].get<double>(), 1e3 * a["p95"].get<double>());
+    }
   }
   std::printf("  files in %s:\n", out.string().c_str());
   for (const char* name :

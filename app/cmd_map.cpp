@@ -2,6 +2,7 @@
 // in; the map (map.h5), the poses used (trajectory.tum / .kitti) and report.json out.
 
 #include <spdlog/spdlog.h>
+#include <Eigen/Eigenvalues>
 
 #include <chrono>
 #include <cstdio>
@@ -97,6 +98,28 @@ std::string format_metres(double metres) {
   char text[32];
   std::snprintf(text, sizeof(text), "%g m", metres);
   return text;
+}
+
+/// The positions of a path spread at least this much (standard deviation) along a second
+/// direction: the alignment of two paths then fixes the rotation about the first one too.
+constexpr double kMinAlignmentSpreadM = 2.0;
+
+/// Whether the path's positions spread `min_m` (standard deviation) in two directions: a
+/// straight path leaves the rotation about itself to chance in any alignment.
+bool spans_a_plane(const slam::Trajectory& path, double min_m) {
+  if (path.size() < 3) return false;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Isometry3d& T : path.poses) mean += T.translation();
+  mean /= static_cast<double>(path.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Eigen::Isometry3d& T : path.poses) {
+    const Eigen::Vector3d d = T.translation() - mean;
+    covariance += d * d.transpose();
+  }
+  covariance /= static_cast<double>(path.size());
+  const Eigen::Vector3d spread =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues();  // ascending
+  return spread(1) >= min_m * min_m;
 }
 
 /// Why the loop closure does not run (empty: it does).
@@ -263,6 +286,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   } else if (odometry) {
     report["loops"] = {{"enabled", false}, {"why", no_loops}};
   }
+  // Where the poses were estimated and the truth is known, the mesh is also scored in the
+  // frame that aligns the two trajectories (evaluate_map_mesh).
+  std::optional<Eigen::Isometry3d> T_truth_estimate;
   if (truth && final_poses.size() >= 2) {
     try {
       const slam::TrajectoryEvaluationSettings eval_settings;
@@ -270,7 +296,11 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
         return trajectory_evaluation_json(
             slam::evaluate_trajectory(trajectory, truth->poses, eval_settings), eval_settings);
       };
-      report["eval"]["traj"] = evaluate(final_poses);
+      const slam::TrajectoryEvaluation final_evaluation =
+          slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
+      report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
+      if (odometry && spans_a_plane(final_poses, kMinAlignmentSpreadM))
+        T_truth_estimate = final_evaluation.alignment.T;
       // The front end's own poses too, to show what the loops and the refinement changed.
       if (loops && !loops->loops.empty())
         report["eval"]["traj_before_loops"] = evaluate(first.poses);
@@ -283,7 +313,8 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   if (!options.no_mesh && !options.poses_only && result.frames_mapped > 0) {
     const MapMesh meshed = mesh_map(out / "map.h5", out);
     report["mesh"] = mesh_json(meshed);
-    if (std::optional<nlohmann::json> evaluation = evaluate_map_mesh(meshed.mesh, references)) {
+    if (std::optional<nlohmann::json> evaluation =
+            evaluate_map_mesh(meshed.mesh, references, T_truth_estimate)) {
       report["eval"]["mesh"] = *evaluation;
     }
   }

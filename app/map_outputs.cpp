@@ -56,8 +56,9 @@ MeshReferences find_mesh_references(const std::string& input,
   return references;
 }
 
-std::optional<nlohmann::json> evaluate_map_mesh(const mesh::TriangleMesh& mesh,
-                                                const MeshReferences& references) {
+std::optional<nlohmann::json> evaluate_map_mesh(
+    const mesh::TriangleMesh& mesh, const MeshReferences& references,
+    const std::optional<Eigen::Isometry3d>& T_truth_estimate) {
   // A reference may be missing: a simulation that was interrupted wrote no ground truth.
   if (!references.surface || !fs::is_regular_file(*references.surface) || mesh.triangles.empty()) {
     return std::nullopt;
@@ -67,6 +68,17 @@ std::optional<nlohmann::json> evaluate_map_mesh(const mesh::TriangleMesh& mesh,
   const mesh::CompareResult against_surface = mesh::compare_to_reference(mesh, surface, settings);
   nlohmann::json json = mesh_comparison_json(against_surface, settings);
   json["reference_file"] = references.surface->string();
+  if (T_truth_estimate) {
+    // The reference moved into the map's frame: the same distances as the mesh moved onto
+    // the truth, for a fraction of the vertices.
+    mesh::TriangleMesh moved = surface;
+    const Eigen::Isometry3f T_estimate_truth = T_truth_estimate->inverse().cast<float>();
+    for (Eigen::Vector3f& v : moved.vertices) v = T_estimate_truth * v;
+    for (Eigen::Vector3f& n : moved.normals) n = T_estimate_truth.linear() * n;
+    const mesh::CompareResult aligned = mesh::compare_to_reference(mesh, moved, settings);
+    json["aligned"] = {{"by", "the estimated trajectory's SE(3) alignment to the true one"},
+                       {"accuracy", mesh_comparison_json(aligned, settings)["accuracy"]}};
+  }
   if (!references.seen || !fs::is_regular_file(*references.seen)) return json;
 
   // Completeness counts only what the sensor saw: the points behind its returns.
