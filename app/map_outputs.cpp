@@ -6,7 +6,7 @@
 #include "featsense/mesh/compare_to_reference.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
-#include "featsense/viewer_export/topdown_image.hpp"
+#include "featsense/viewer_export/plan_view.hpp"
 
 namespace featsense::app {
 namespace {
@@ -26,7 +26,7 @@ MapMesh mesh_map(const fs::path& map_path, const fs::path& out) {
   const Clock::time_point start = Clock::now();
   viewer_export::write_mesh((out / "mesh.ply").string(), result.mesh);
   viewer_export::write_mesh((out / "mesh.glb").string(), result.mesh);
-  viewer_export::write_topdown_png(result.mesh, (out / "topdown.png").string());
+  viewer_export::write_plan_view_png(result.mesh, {}, (out / "topdown.png").string());
   result.write_s = std::chrono::duration<double>(Clock::now() - start).count();
   return result;
 }
