@@ -141,8 +141,10 @@ void draw_legend(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanS
   const int ramp = 8 * style.text_height;
   char low[32];
   char high[32];
-  std::snprintf(low, sizeof(low), "z %.1f m", legend.colours.low_m);
-  std::snprintf(high, sizeof(high), "%.1f m", legend.colours.high_m);
+  // Rounded first, so that a floor a millimetre below zero reads 0.0, not -0.0.
+  const auto decimetres = [](double z) { return std::round(z * 10.0) / 10.0 + 0.0; };
+  std::snprintf(low, sizeof(low), "z %.1f m", decimetres(legend.colours.low_m));
+  std::snprintf(high, sizeof(high), "%.1f m", decimetres(legend.colours.high_m));
 
   int width = text_width(legend.cut, style);
   for (const PlanPath& path : paths)

@@ -14,8 +14,8 @@ constexpr uint8_t kOutline = 90;
 /// A height difference between neighbouring pixels that is an object's edge, not a slope.
 constexpr float kStepM = 0.15f;
 /// How wide walls are drawn (at least a pixel, at most four): a marching-cubes wall is one
-/// pixel thin, too faint in the fine pixels of a small map.
-constexpr double kWallLineM = 0.05;
+/// pixel thin, too faint beside the floor's colours.
+constexpr double kWallLineM = 0.1;
 constexpr double kMinColourSpanM = 1.0;
 
 double percentile(std::vector<float> values, double q) {
