@@ -24,18 +24,23 @@ TEST(CliDemo, EstimatesThePosesAndScoresPathAndMesh) {
   EXPECT_EQ(report["eval"]["traj"]["ape"]["count"].get<int>(), 8);
   EXPECT_LT(report["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);
   EXPECT_TRUE(report["eval"].contains("mesh"));
+  // The plan view, cut 0.3 m above the lab's walk at 1.7 m, under its 4 m ceiling.
+  EXPECT_TRUE(fs::is_regular_file(out / "topdown.png"));
+  const nlohmann::json& plan = report["mesh"]["plan"];
+  EXPECT_NEAR(plan["cut_high_m"].get<double>(), 2.0, 0.05) << plan.dump(2);
 }
 
 TEST(CliDemo, GtPosesMapsWithTheTruth) {
   const fs::path out = scratch_dir("cli_demo") / "true";
-  const CommandResult r =
-      run_featsense("demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses");
+  const CommandResult r = run_featsense(
+      "demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses" + " --plan-height 2.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mapped with the true poses"), std::string::npos) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
   EXPECT_FALSE(report.contains("odometry"));
   EXPECT_FALSE(report["eval"].contains("traj"));
   EXPECT_TRUE(report["eval"].contains("mesh"));
+  EXPECT_EQ(report["mesh"]["plan"]["cut_low_m"].get<double>(), 2.5);
 }
 
 }  // namespace
