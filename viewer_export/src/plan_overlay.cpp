@@ -93,11 +93,12 @@ void draw_grid(std::vector<uint8_t>& rgba, const PlanFrame& frame, double spacin
 void draw_paths(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanStyle& style,
                 const std::vector<PlanPath>& paths) {
   cv::Mat image = as_mat(rgba, frame);
-  const int width = style.path_width;
   // Sub-pixel positions: OpenCV's fixed point with 4 fractional bits.
   constexpr int kShift = 4;
   constexpr double kScale = 1 << kShift;
   for (const PlanPath::Kind kind : {PlanPath::Kind::kTruth, PlanPath::Kind::kEstimate}) {
+    // The truth wider, below: where an estimate lies on it, both show (red edged in blue).
+    const int line = kind == PlanPath::Kind::kTruth ? style.path_width + 2 : style.path_width;
     for (const PlanPath& path : paths) {
       if (path.kind != kind || path.positions_m.empty()) continue;
       std::vector<cv::Point> points;
@@ -109,8 +110,8 @@ void draw_paths(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanSt
         if (points.empty() || point != points.back()) points.push_back(point);
       }
       if (points.empty()) continue;
-      cv::polylines(image, points, false, colour_of(kind), width, cv::LINE_AA, kShift);
-      cv::circle(image, points.front(), static_cast<int>((width + 2) * kScale), colour_of(kind),
+      cv::polylines(image, points, false, colour_of(kind), line, cv::LINE_AA, kShift);
+      cv::circle(image, points.front(), static_cast<int>((line + 2) * kScale), colour_of(kind),
                  cv::FILLED, cv::LINE_AA, kShift);
     }
   }
