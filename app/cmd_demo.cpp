@@ -24,6 +24,7 @@ struct DemoOptions {
   int frames = 0;         ///< 0: the whole path
   bool gt_poses = false;  ///< map with the true poses instead of the odometry's
   std::optional<std::string> backend;
+  std::optional<double> plan_height;  ///< topdown.png's cut
 };
 
 std::string percent(const nlohmann::json& fraction) {
@@ -95,6 +96,7 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   map.backend = options.backend;
   map.overwrite = true;  // the demo's own folder: a second demo replaces the first
   map.print_summary = false;
+  map.plan_height = options.plan_height;
   // Bad --config / --set fail before the simulation.
   const config::Config config = map_config(map, context);
   SimulateOptions simulate;
@@ -152,6 +154,7 @@ Command register_demo(CLI::App& app, const CliContext& context) {
   command->add_flag("--gt-poses", options->gt_poses,
                     "Map with the true poses instead of estimating them with the odometry");
   add_config_option(*command, kBackendOption, options->backend);
+  add_plan_height_option(*command, options->plan_height);
   return {command, [options, &context] { run_demo(*options, context); }};
 }
 

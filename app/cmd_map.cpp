@@ -122,6 +122,22 @@ bool spans_a_plane(const slam::Trajectory& path, double min_m) {
   return spread(1) >= min_m * min_m;
 }
 
+/// What topdown.png draws: the poses the map was made with and, where it lies in the map's
+/// frame (a simulation's, which the map starts from), the true path. A --reference-trajectory
+/// is in a frame of its own (the evaluation aligns it): it is not drawn.
+PlanInputs plan_inputs(const MapOptions& options, const slam::Trajectory& final_poses,
+                       bool given_poses, const std::optional<KnownTrajectory>& truth) {
+  PlanInputs plan;
+  plan.settings.cut_height_m = options.plan_height;
+  if (truth && truth->starts_at_first_scan) {
+    plan.paths.push_back(
+        plan_path(truth->poses, viewer_export::PlanPath::Kind::kTruth, "true path"));
+  }
+  plan.paths.push_back(plan_path(final_poses, viewer_export::PlanPath::Kind::kEstimate,
+                                 given_poses ? "given path" : "estimated path"));
+  return plan;
+}
+
 /// Why the loop closure does not run (empty: it does).
 std::string loop_closure_off_because(bool odometry, const MapOptions& options,
                                      const config::Config& config) {
@@ -311,7 +327,8 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     }
   }
   if (!options.no_mesh && !options.poses_only && result.frames_mapped > 0) {
-    const MapMesh meshed = mesh_map(out / "map.h5", out);
+    const MapMesh meshed =
+        mesh_map(out / "map.h5", out, plan_inputs(options, final_poses, given != nullptr, truth));
     report["mesh"] = mesh_json(meshed);
     if (std::optional<nlohmann::json> evaluation =
             evaluate_map_mesh(meshed.mesh, references, T_truth_estimate)) {
@@ -362,7 +379,9 @@ Command register_map(CLI::App& app, const CliContext& context) {
                       "First scan to map: a frame index, or seconds after the first scan (12.5s)");
   command->add_option("--end", options->end, "Last scan to map (as --start)");
   command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
-  command->add_flag("--no-mesh", options->no_mesh, "Write the map only, no mesh.ply / mesh.glb");
+  command->add_flag("--no-mesh", options->no_mesh,
+                    "Write the map only, no mesh.ply / mesh.glb / topdown.png");
+  add_plan_height_option(*command, options->plan_height);
   command->add_flag("--no-loop-closure", options->no_loop_closure,
                     "Map with the odometry's poses alone (loop.enabled false)");
   command->add_flag("--poses-only", options->poses_only,

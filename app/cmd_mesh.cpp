@@ -1,4 +1,5 @@
-// featsense mesh MAP -o MESH: marching cubes over a stored map (.h5 or .vdb), one welded mesh.
+// featsense mesh MAP -o MESH [--plan PNG]: marching cubes over a stored map (.h5 or .vdb), one
+// welded mesh, and its plan view.
 
 #include <spdlog/spdlog.h>
 
@@ -14,11 +15,13 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/mesh/marching_cubes.hpp"
 #include "featsense/mesh/mesh_cleanup.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/storage/memory_chunk_store.hpp"
 #include "featsense/storage/vdb_io.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "json_output.hpp"
+#include "map_outputs.hpp"
 
 namespace featsense::app {
 namespace {
@@ -36,7 +39,31 @@ struct MeshOptions {
   double max_hole_perimeter_m = 1.0;
   bool check_self_intersections = false;
   std::optional<std::string> json_path;
+  std::optional<std::string> plan_path;        ///< the plan view, PNG
+  std::optional<double> plan_height;           ///< its cut
+  std::optional<std::string> trajectory_path;  ///< the path drawn on it (and its cut)
 };
+
+/// --plan's options make sense only with it, and the file must be a PNG.
+void check_plan_options(const MeshOptions& options) {
+  if (!options.plan_path) {
+    if (options.plan_height) throw config::ConfigError("--plan-height goes with --plan FILE.png");
+    if (options.trajectory_path)
+      throw config::ConfigError("--trajectory goes with --plan FILE.png");
+    return;
+  }
+  if (viewer_export::mesh_extension(*options.plan_path) != ".png") {
+    throw config::ConfigError("--plan: the plan view is a PNG file, got '" + *options.plan_path +
+                              "'");
+  }
+}
+
+/// The --trajectory's path, read before the meshing so that a bad file fails at once.
+std::vector<viewer_export::PlanPath> plan_paths(const MeshOptions& options) {
+  if (!options.trajectory_path) return {};
+  return {plan_path(slam::read_trajectory(*options.trajectory_path),
+                    viewer_export::PlanPath::Kind::kEstimate, "path")};
+}
 
 /// "xmin,ymin,zmin,xmax,ymax,zmax" in metres.
 Eigen::AlignedBox3d parse_bbox(const std::string& text) {
@@ -112,6 +139,8 @@ void run_mesh(const MeshOptions& options) {
   if (!(options.min_component_area_m2 >= 0.0) || !(options.max_hole_perimeter_m >= 0.0)) {
     throw config::ConfigError("--min-component-area and --max-hole must be >= 0");
   }
+  check_plan_options(options);
+  const std::vector<viewer_export::PlanPath> paths = plan_paths(options);
   mesh::MeshingSettings settings;
   settings.min_weight = options.min_weight;
   settings.threads = options.threads;
@@ -144,6 +173,13 @@ void run_mesh(const MeshOptions& options) {
     }
   }
   viewer_export::write_mesh(options.output, result);
+  std::optional<viewer_export::PlanView> plan;
+  if (options.plan_path) {
+    // The path, where given, sets the cut; --plan-height overrides it.
+    viewer_export::PlanViewSettings plan_settings;
+    plan_settings.cut_height_m = options.plan_height;
+    plan = viewer_export::write_plan_view_png(result, paths, *options.plan_path, plan_settings);
+  }
 
   const double triangles_per_s =
       stats.seconds > 0.0 ? static_cast<double>(stats.triangles) / stats.seconds : 0.0;
@@ -160,6 +196,11 @@ void run_mesh(const MeshOptions& options) {
         cleanup->non_manifold_vertices_fixed, cleanup->holes_filled,
         cleanup->simplification_max_error_m, cleanup->simplification_mean_error_m,
         cleanup->is_closed ? "closed" : "open", cleanup->is_manifold ? "manifold" : "not manifold");
+  }
+  if (plan) {
+    std::printf("plan view: %s, %d x %d pixels of %.3f m, grid %g m; cut: %s\n",
+                options.plan_path->c_str(), plan->width_px, plan->height_px, plan->pixel_size_m,
+                plan->grid_spacing_m, plan->cut_rule.c_str());
   }
   if (options.json_path) {
     nlohmann::json report = {{"map", options.map},
@@ -198,6 +239,7 @@ void run_mesh(const MeshOptions& options) {
       if (options.check_self_intersections)
         report["cleanup"]["self_intersections"] = c.self_intersections;
     }
+    if (plan) report["plan"] = plan_json(*plan, *options.plan_path);
     write_json(report, *options.json_path);
   }
 }
@@ -241,6 +283,14 @@ Command register_mesh(CLI::App& app, const CliContext& /*context*/) {
   command->add_flag("--check-self-intersections", options->check_self_intersections,
                     "Count self-intersecting triangle pairs of the result (slow on big meshes)");
   command->add_option("--json", options->json_path, "Write the figures as JSON ('-' = stdout)");
+  command->add_option("--plan", options->plan_path,
+                      "Also write the plan view: the mesh seen from above below a cut height, "
+                      "with a grid and a scale bar (PNG)");
+  add_plan_height_option(*command, options->plan_height);
+  command
+      ->add_option("--trajectory", options->trajectory_path,
+                   "With --plan: the sensor's path (TUM or KITTI) to draw and to cut above")
+      ->check(CLI::ExistingFile);
   return {command, [options] { run_mesh(*options); }};
 }
 

@@ -29,6 +29,7 @@ struct MapOptions {
   std::optional<std::string> end;
   std::optional<std::string> reference;
   std::optional<std::string> reference_trajectory;  ///< the true path, for eval.traj
+  std::optional<double> plan_height;  ///< topdown.png's cut, map frame z; default: the path's
   bool overwrite = false;
   bool no_mesh = false;
   bool no_loop_closure = false;  ///< loop.enabled false

@@ -1,12 +1,13 @@
 #include "map_outputs.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "eval_json.hpp"
 #include "featsense/mesh/compare_to_reference.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
-#include "featsense/viewer_export/topdown_image.hpp"
+#include "featsense/viewer_export/plan_view.hpp"
 
 namespace featsense::app {
 namespace {
@@ -16,7 +17,27 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
-MapMesh mesh_map(const fs::path& map_path, const fs::path& out) {
+void add_plan_height_option(CLI::App& command, std::optional<double>& height_m) {
+  command
+      .add_option("--plan-height", height_m,
+                  "Cut the plan view (topdown.png) at this height, metres, map frame (default: "
+                  "0.3 m above the path near each place; without a path, 1.5 m above the floor "
+                  "where there is a ceiling)")
+      ->check(CLI::Number);
+}
+
+viewer_export::PlanPath plan_path(const slam::Trajectory& trajectory,
+                                  viewer_export::PlanPath::Kind kind, const std::string& label) {
+  viewer_export::PlanPath path;
+  path.kind = kind;
+  path.label = label;
+  path.positions_m.reserve(trajectory.size());
+  for (const Eigen::Isometry3d& T_map_sensor : trajectory.poses)
+    path.positions_m.push_back(T_map_sensor.translation());
+  return path;
+}
+
+MapMesh mesh_map(const fs::path& map_path, const fs::path& out, const PlanInputs& plan) {
   MapMesh result;
   storage::StoreSettings store_settings;
   store_settings.cache_bytes = std::size_t{128} << 20;
@@ -26,19 +47,36 @@ MapMesh mesh_map(const fs::path& map_path, const fs::path& out) {
   const Clock::time_point start = Clock::now();
   viewer_export::write_mesh((out / "mesh.ply").string(), result.mesh);
   viewer_export::write_mesh((out / "mesh.glb").string(), result.mesh);
-  viewer_export::write_topdown_png(result.mesh, (out / "topdown.png").string());
+  const fs::path plan_file = out / "topdown.png";
+  result.plan = viewer_export::write_plan_view_png(result.mesh, plan.paths, plan_file.string(),
+                                                   plan.settings);
   result.write_s = std::chrono::duration<double>(Clock::now() - start).count();
   return result;
 }
 
 nlohmann::json mesh_json(const MapMesh& result) {
   const double s = result.stats.seconds;
-  return {{"vertices", result.stats.vertices},
-          {"triangles", result.stats.triangles},
-          {"chunks", result.stats.chunks},
-          {"seconds", s},
-          {"triangles_per_s", s > 0.0 ? static_cast<double>(result.stats.triangles) / s : 0.0},
-          {"write_s", result.write_s}};
+  nlohmann::json json = {
+      {"vertices", result.stats.vertices},
+      {"triangles", result.stats.triangles},
+      {"chunks", result.stats.chunks},
+      {"seconds", s},
+      {"triangles_per_s", s > 0.0 ? static_cast<double>(result.stats.triangles) / s : 0.0},
+      {"write_s", result.write_s}};
+  if (result.plan) json["plan"] = plan_json(*result.plan, "topdown.png");
+  return json;
+}
+
+nlohmann::json plan_json(const viewer_export::PlanView& plan, const std::string& file) {
+  const auto height = [](double z) { return std::isfinite(z) ? nlohmann::json(z) : nullptr; };
+  return {{"file", file},
+          {"width_px", plan.width_px},
+          {"height_px", plan.height_px},
+          {"pixel_size_m", plan.pixel_size_m},
+          {"grid_spacing_m", plan.grid_spacing_m},
+          {"cut", plan.cut_rule},
+          {"cut_low_m", height(plan.cut_low_m)},
+          {"cut_high_m", height(plan.cut_high_m)}};
 }
 
 MeshReferences find_mesh_references(const std::string& input,

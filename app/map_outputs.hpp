@@ -1,7 +1,8 @@
 #pragma once
-// What `featsense map` makes of a finished map: the mesh (mesh.ply, mesh.glb) and, where a
-// reference is known, its evaluation.
+// What `featsense map` makes of a finished map: the mesh (mesh.ply, mesh.glb), its plan view
+// (topdown.png) and, where a reference is known, its evaluation.
 
+#include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
@@ -11,19 +12,41 @@
 
 #include "featsense/mesh/marching_cubes.hpp"
 #include "featsense/mesh/triangle_mesh.hpp"
+#include "featsense/slam/trajectory/trajectory.hpp"
+#include "featsense/viewer_export/plan_view.hpp"
 
 namespace featsense::app {
 
 struct MapMesh {
   mesh::TriangleMesh mesh;
   mesh::MeshingStats stats;
+  std::optional<viewer_export::PlanView> plan;  ///< what topdown.png shows
   double write_s = 0.0;
 };
 
-/// Meshes the map at `map_path` and writes `out`/mesh.ply, mesh.glb and topdown.png (a
-/// height-coloured view from above).
-MapMesh mesh_map(const std::filesystem::path& map_path, const std::filesystem::path& out);
+/// What the plan view draws besides the mesh: the paths in the map frame, and its settings
+/// (--plan-height).
+struct PlanInputs {
+  std::vector<viewer_export::PlanPath> paths;
+  viewer_export::PlanViewSettings settings;
+};
+
+/// --plan-height Z: topdown.png's cut, for map, demo and mesh.
+void add_plan_height_option(CLI::App& command, std::optional<double>& height_m);
+
+/// A trajectory's positions as a path of the plan view.
+viewer_export::PlanPath plan_path(const slam::Trajectory& trajectory,
+                                  viewer_export::PlanPath::Kind kind, const std::string& label);
+
+/// Meshes the map at `map_path` and writes `out`/mesh.ply, mesh.glb and topdown.png (the plan
+/// view: the map cut below its ceilings, seen from above, with `plan`'s paths).
+MapMesh mesh_map(const std::filesystem::path& map_path, const std::filesystem::path& out,
+                 const PlanInputs& plan);
 nlohmann::json mesh_json(const MapMesh& result);
+
+/// The report's account of a plan view written to `file`: its size, its pixels and grid, and
+/// where it was cut (null where nothing was).
+nlohmann::json plan_json(const viewer_export::PlanView& plan, const std::string& file);
 
 /// Where the truth of a map's surface is: accuracy is measured against `surface` (a mesh),
 /// completeness against `seen` (points of the surface the sensor saw, e.g. the simulator's

@@ -27,12 +27,16 @@ TEST(CliDemo, EstimatesThePosesAndScoresPathAndMesh) {
   // Eight scans along a straight line: an alignment of the paths would turn the mesh about the
   // line at random, so the mesh is scored as mapped only.
   EXPECT_FALSE(report["eval"]["mesh"].contains("aligned"));
+  // The plan view, cut 0.3 m above the lab's walk at 1.7 m, under its 4 m ceiling.
+  EXPECT_TRUE(fs::is_regular_file(out / "topdown.png"));
+  const nlohmann::json& plan = report["mesh"]["plan"];
+  EXPECT_NEAR(plan["cut_high_m"].get<double>(), 2.0, 0.05) << plan.dump(2);
 }
 
 TEST(CliDemo, GtPosesMapsWithTheTruth) {
   const fs::path out = scratch_dir("cli_demo") / "true";
-  const CommandResult r =
-      run_featsense("demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses");
+  const CommandResult r = run_featsense(
+      "demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses" + " --plan-height 2.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("mapped with the true poses"), std::string::npos) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
@@ -40,6 +44,7 @@ TEST(CliDemo, GtPosesMapsWithTheTruth) {
   EXPECT_FALSE(report["eval"].contains("traj"));
   ASSERT_TRUE(report["eval"].contains("mesh"));
   EXPECT_FALSE(report["eval"]["mesh"].contains("aligned"));  // the map's frame is the truth's
+  EXPECT_EQ(report["mesh"]["plan"]["cut_low_m"].get<double>(), 2.5);
 }
 
 }  // namespace

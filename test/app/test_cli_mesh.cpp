@@ -78,6 +78,38 @@ TEST(CliMesh, MeshesH5AndVdbMaps) {
   EXPECT_LT(d.triangles.size(), a.triangles.size() / 3);
 }
 
+TEST(CliMesh, WritesThePlanView) {
+  const std::filesystem::path dir = write_sphere_map("cli_mesh_plan");
+  const std::string json = (dir / "mesh.json").string();
+  const std::string plan = (dir / "plan.png").string();
+  CommandResult result =
+      run_featsense("mesh " + (dir / "map.h5").string() + " -o " + (dir / "a.ply").string() +
+                    " --plan " + plan + " --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(plan));
+  EXPECT_NE(result.output.find("plan view: " + plan), std::string::npos) << result.output;
+  nlohmann::json figures;
+  std::ifstream(json) >> figures;
+  // A ball has no ceiling over a floor: without a path nothing is cut.
+  EXPECT_TRUE(figures["plan"]["cut_low_m"].is_null()) << figures.dump(2);
+  EXPECT_GT(figures["plan"]["width_px"].get<int>(), 0);
+
+  // A path through the ball's middle: the cut follows it, --plan-height overrides that.
+  const std::string tum = (dir / "path.tum").string();
+  std::ofstream(tum) << "0.0 -0.5 0 0 0 0 0 1\n1.0 0.5 0 0 0 0 0 1\n";
+  result = run_featsense("mesh " + (dir / "map.h5").string() + " -o " + (dir / "b.ply").string() +
+                         " --plan " + plan + " --trajectory " + tum + " --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream(json) >> figures;
+  EXPECT_NEAR(figures["plan"]["cut_low_m"].get<double>(), 0.3, 1e-9);
+  result = run_featsense("mesh " + (dir / "map.h5").string() + " -o " + (dir / "c.ply").string() +
+                         " --plan " + plan + " --trajectory " + tum + " --plan-height -0.2" +
+                         " --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream(json) >> figures;
+  EXPECT_NEAR(figures["plan"]["cut_high_m"].get<double>(), -0.2, 1e-9);
+}
+
 TEST(CliMesh, ErrorsAreClear) {
   const std::filesystem::path dir = write_sphere_map("cli_mesh_errors");
   const std::string map = (dir / "map.h5").string();
@@ -106,6 +138,8 @@ TEST(CliMesh, ErrorsAreClear) {
       {"mesh " + map + out + " --simplify 1.5", "--simplify: the fraction"},
       {"mesh " + map + " -o " + (dir / "out.stl").string(), "unknown mesh format '.stl'"},
       {"mesh " + map + out + " --bbox 10,10,10,11,11,11", "no surface to mesh inside --bbox"},
+      {"mesh " + map + out + " --plan-height 1", "--plan-height goes with --plan"},
+      {"mesh " + map + out + " --plan " + (dir / "plan.jpg").string(), "the plan view is a PNG"},
   };
   for (const Case& c : cases) {
     const CommandResult result = run_featsense(c.args);
