@@ -18,6 +18,7 @@
 #include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/refine/segment_refiner.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
+#include "featsense/slam/trajectory/scan_motions.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "front_end_report.hpp"
@@ -237,8 +238,11 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       std::optional<MapPassOutput> replayed;
       try {
         const std::unique_ptr<slam::ScanSource> again = reopen();
+        // Each scan deskewed as the first pass placed it (scan_motions.hpp), from its
+        // corrected pose.
         const std::unique_ptr<slam::ScanLocator> corrected =
-            slam::make_given_pose_locator(loops->corrected, config.odometry.deskew);
+            config.odometry.deskew ? slam::make_replay_locator(loops->corrected, first.scan_motions)
+                                   : slam::make_given_pose_locator(loops->corrected, false);
         PipelineSettings replay = pipeline;
         replay.refine.reset();
         replay.loops.reset();

@@ -158,6 +158,7 @@ void make_rays(BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out, Loo
   while (std::optional<PlacedScan> placed = in.pop()) {
     const Clock::time_point start = Clock::now();
     if (loops && !loops->offer(placed->scan, placed->placement)) break;
+    if (loops) result.scan_motions.add(placed->scan, placed->placement);
     LocatedScan located;
     if (integrate) located.rays = scan_to_rays(placed->scan, placed->placement);
     located.placement = std::move(placed->placement);

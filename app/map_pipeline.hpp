@@ -18,6 +18,7 @@
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/scan_source.hpp"
+#include "featsense/slam/trajectory/scan_motions.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/shifting_map.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
@@ -86,6 +87,8 @@ struct PipelineResult {
   std::vector<double> refine_cloud_ms;  ///< per cloud made
   size_t refine_most_held = 0;          ///< the most scans waiting for their final pose
   std::optional<LoopOutcome> loops;     ///< with loop closure
+  /// With loop closure: each scan's motion as placed, for the second pass.
+  slam::ScanMotions scan_motions;
   size_t warning_count = 0;
   std::vector<std::string> warnings;  ///< the first few, verbatim
   bool interrupted = false;           ///< stopped by Ctrl+C / SIGTERM
