@@ -9,7 +9,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -74,8 +73,10 @@ uint32_t le32(const std::string& bytes, size_t at) {
 }
 
 GlbChunks read_glb(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::string file(static_cast<size_t>(in.tellg()), '\0');
+  in.seekg(0);
+  in.read(file.data(), static_cast<std::streamsize>(file.size()));
   GlbChunks chunks;
   if (file.size() < 20 || file.compare(0, 4, "glTF") != 0) {
     ADD_FAILURE() << path << " is not a GLB";
