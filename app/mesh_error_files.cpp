@@ -1,5 +1,7 @@
 #include "mesh_error_files.hpp"
 
+#include <cmath>
+
 #include "featsense/viewer_export/error_colours.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 
@@ -26,10 +28,12 @@ nlohmann::json write_mesh_error_files(const std::filesystem::path& out,
       viewer_export::signed_distance_plan_colours(result.signed_distance_m);
   viewer_export::write_plan_view_png(mesh, paths, (out / "mesh_error.png").string(), plan_settings,
                                      &plan_colours);
-  return {{"ply", "mesh_error.ply"},
-          {"glb", "mesh_error.glb"},
-          {"png", "mesh_error.png"},
-          {"colour_saturation_m", viewer_export::kErrorSaturationM}};
+  return {
+      {"ply", "mesh_error.ply"},
+      {"glb", "mesh_error.glb"},
+      {"png", "mesh_error.png"},
+      // The float constant as the decimal it was written as, not 0.10000000149.
+      {"colour_saturation_m", std::round(1e6 * double{viewer_export::kErrorSaturationM}) / 1e6}};
 }
 
 }  // namespace featsense::app
