@@ -13,6 +13,7 @@
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/viewer_export/ply_mesh_io.hpp"
 #include "json_output.hpp"
+#include "mesh_error_files.hpp"
 
 namespace featsense::app {
 namespace {
@@ -124,10 +125,7 @@ void run_mesh(const EvalMeshOptions& options) {
     throw std::runtime_error(options.estimate + " vs " + options.reference + ": " + e.what());
   }
   if (options.ply_path) {
-    viewer_export::MeshAttributes attributes;
-    attributes.scalars.push_back({"distance", result.unsigned_distance_m});
-    attributes.scalars.push_back({"signed_distance", result.signed_distance_m});
-    viewer_export::write_ply_mesh(*options.ply_path, estimate, attributes);
+    viewer_export::write_ply_mesh(*options.ply_path, estimate, distance_layers(result));
   }
   nlohmann::json json = mesh_comparison_json(result, settings);
   json["estimate"] = options.estimate;

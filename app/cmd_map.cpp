@@ -331,11 +331,12 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     }
   }
   if (!options.no_mesh && !options.poses_only && result.frames_mapped > 0) {
-    const MapMesh meshed =
-        mesh_map(out / "map.h5", out, plan_inputs(options, final_poses, given != nullptr, truth));
+    const MeshErrorOutputs error_outputs{
+        out, plan_inputs(options, final_poses, given != nullptr, truth)};
+    const MapMesh meshed = mesh_map(out / "map.h5", out, error_outputs.plan);
     report["mesh"] = mesh_json(meshed);
     if (std::optional<nlohmann::json> evaluation =
-            evaluate_map_mesh(meshed.mesh, references, T_truth_estimate)) {
+            evaluate_map_mesh(meshed.mesh, references, T_truth_estimate, &error_outputs)) {
       report["eval"]["mesh"] = *evaluation;
     }
   }

@@ -8,6 +8,7 @@
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/plan_view.hpp"
+#include "mesh_error_files.hpp"
 
 namespace featsense::app {
 namespace {
@@ -96,7 +97,8 @@ MeshReferences find_mesh_references(const std::string& input,
 
 std::optional<nlohmann::json> evaluate_map_mesh(
     const mesh::TriangleMesh& mesh, const MeshReferences& references,
-    const std::optional<Eigen::Isometry3d>& T_truth_estimate) {
+    const std::optional<Eigen::Isometry3d>& T_truth_estimate,
+    const MeshErrorOutputs* error_outputs) {
   // A reference may be missing: a simulation that was interrupted wrote no ground truth.
   if (!references.surface || !fs::is_regular_file(*references.surface) || mesh.triangles.empty()) {
     return std::nullopt;
@@ -106,6 +108,11 @@ std::optional<nlohmann::json> evaluate_map_mesh(
   const mesh::CompareResult against_surface = mesh::compare_to_reference(mesh, surface, settings);
   nlohmann::json json = mesh_comparison_json(against_surface, settings);
   json["reference_file"] = references.surface->string();
+  if (error_outputs) {
+    json["error_files"] =
+        write_mesh_error_files(error_outputs->dir, mesh, against_surface, error_outputs->plan.paths,
+                               error_outputs->plan.settings);
+  }
   if (T_truth_estimate) {
     // The reference moved into the map's frame: the same distances as the mesh moved onto
     // the truth, for a fraction of the vertices.

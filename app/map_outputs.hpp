@@ -56,6 +56,13 @@ struct MeshReferences {
   std::optional<std::filesystem::path> seen;
 };
 
+/// Where evaluate_map_mesh shows the mesh's error: the folder, and the plan view's paths and
+/// cut, so that mesh_error.png is cut as topdown.png is.
+struct MeshErrorOutputs {
+  std::filesystem::path dir;
+  PlanInputs plan;
+};
+
 /// The user's reference mesh when given; else the ground truth beside a simulated sequence
 /// (gt_mesh.ply and gt_points.ply in the INPUT folder); else none.
 MeshReferences find_mesh_references(const std::string& input,
@@ -67,8 +74,11 @@ MeshReferences find_mesh_references(const std::string& input,
 /// accuracy of the mesh so aligned, as `aligned`: a map made without an absolute reference
 /// (no gravity, no survey points) keeps its first pose's frame, and a tilt of 0.05 deg in
 /// its first metres puts a wall 200 m away 17 cm too high however consistent the map is.
+/// With `error_outputs`, the distances to `surface` (in the map's frame, as the plain score)
+/// are written as mesh_error.ply, .glb and .png (mesh_error_files.hpp), named in `error_files`.
 std::optional<nlohmann::json> evaluate_map_mesh(
     const mesh::TriangleMesh& mesh, const MeshReferences& references,
-    const std::optional<Eigen::Isometry3d>& T_truth_estimate = std::nullopt);
+    const std::optional<Eigen::Isometry3d>& T_truth_estimate = std::nullopt,
+    const MeshErrorOutputs* error_outputs = nullptr);
 
 }  // namespace featsense::app

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -7,6 +8,7 @@
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
 
 namespace featsense::test {
 namespace {
@@ -45,6 +47,39 @@ TEST(CliDemo, GtPosesMapsWithTheTruth) {
   ASSERT_TRUE(report["eval"].contains("mesh"));
   EXPECT_FALSE(report["eval"]["mesh"].contains("aligned"));  // the map's frame is the truth's
   EXPECT_EQ(report["mesh"]["plan"]["cut_low_m"].get<double>(), 2.5);
+}
+
+// The error made visible: the distances as CloudCompare's scalar fields, and as colours a glTF
+// viewer shows, named in the report.
+TEST(CliDemo, WritesTheMeshErrorAsFieldsAndColours) {
+  const fs::path out = scratch_dir("cli_demo") / "error";
+  const CommandResult r =
+      run_featsense("demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(out / "report.json");
+  const nlohmann::json& files = report["eval"]["mesh"]["error_files"];
+  EXPECT_EQ(files["ply"], "mesh_error.ply") << report["eval"]["mesh"].dump(2);
+  EXPECT_EQ(files["glb"], "mesh_error.glb");
+
+  viewer_export::MeshAttributes fields;
+  const mesh::TriangleMesh with_fields =
+      viewer_export::read_mesh((out / "mesh_error.ply").string(), &fields);
+  ASSERT_EQ(fields.scalars.size(), 2u);
+  EXPECT_EQ(fields.scalars[0].name, "distance");
+  EXPECT_EQ(fields.scalars[1].name, "signed_distance");
+  ASSERT_EQ(fields.scalars[1].values.size(), with_fields.vertices.size());
+  EXPECT_EQ(with_fields.vertices.size(), report["mesh"]["vertices"].get<size_t>());
+  // |signed| is |d| or, where the nearest point is on an edge seen side on, less (its sign
+  // then says nothing: the comparison gives 0).
+  for (size_t i = 0; i < with_fields.vertices.size(); ++i)
+    ASSERT_LE(std::abs(fields.scalars[1].values[i]), fields.scalars[0].values[i] + 1e-6f);
+
+  viewer_export::MeshAttributes colours;
+  const mesh::TriangleMesh coloured =
+      viewer_export::read_mesh((out / "mesh_error.glb").string(), &colours);
+  EXPECT_EQ(coloured.vertices.size(), with_fields.vertices.size());
+  EXPECT_EQ(colours.colors.size(), coloured.vertices.size());
+  EXPECT_NE(r.output.find("mesh_error.glb"), std::string::npos) << r.output;
 }
 
 }  // namespace

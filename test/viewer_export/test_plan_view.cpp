@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -219,6 +220,40 @@ TEST(PlanView, TheTruthIsDrawnBlueBesideTheEstimate) {
   EXPECT_GT(blue[2], 150);
   EXPECT_LT(blue[0], 100);
   EXPECT_TRUE(is_red(plan.rgba(5.0, 2.0)));
+}
+
+// Surfaces in their vertices' colours (mesh_error.png): the room's floor, in the colour its
+// vertices carry, where the height ramp would be; its walls too; the cut and the path as ever.
+TEST(PlanView, VertexColoursReplaceTheHeightColours) {
+  const mesh::TriangleMesh mesh = room();
+  PlanVertexColours colours;
+  colours.rgb.assign(mesh.vertices.size(), Eigen::Matrix<uint8_t, 3, 1>(40, 200, 60));
+  // The table's top in blue: the vertices at its height (its top, its sides' upper edges).
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (std::abs(mesh.vertices[v].z() - 0.75f) < 1e-6f) colours.rgb[v] = {20, 20, 230};
+  }
+  colours.low = "low";
+  colours.high = "high";
+  colours.ramp = [](double t) {
+    const auto level = static_cast<uint8_t>(std::lround(255.0 * t));
+    return std::array<uint8_t, 3>{level, level, level};
+  };
+  const Plan plan{render_plan_view(mesh, {path_through_room()}, fixed_pixels(), &colours)};
+  // Off the grid's lines; level, so lit as it is.
+  const unsigned char* floor = plan.rgba(5.5, 7.5);
+  EXPECT_EQ(floor[0], 40);
+  EXPECT_EQ(floor[1], 200);
+  EXPECT_EQ(floor[2], 60);
+  const unsigned char* table = plan.rgba(6.7, 6.3);
+  EXPECT_GT(table[2], 150);
+  EXPECT_LT(table[0], 50);
+  const unsigned char* wall = plan.rgba(0.0, 5.0);
+  EXPECT_GT(wall[1], wall[0] + 50) << "a wall keeps its vertices' green";
+  EXPECT_NEAR(plan.image.view.cut_low_m, 1.8, 1e-6);
+  EXPECT_TRUE(is_red(plan.rgba(5.0, 2.0)));
+
+  colours.rgb.pop_back();
+  EXPECT_THROW(render_plan_view(mesh, {}, fixed_pixels(), &colours), mesh::MeshError);
 }
 
 TEST(PlanView, AFixedCutHeightOverridesThePath) {

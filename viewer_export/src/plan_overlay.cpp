@@ -135,17 +135,23 @@ void draw_scale_bar(std::vector<uint8_t>& rgba, const PlanFrame& frame, const Pl
   cv::rectangle(image, cv::Rect(left + style.gap, bar_top, bar, bar_height), kInk, cv::FILLED);
 }
 
+PlanRampLegend height_ramp_legend(const HeightRange& colours) {
+  char low[32];
+  char high[32];
+  // Rounded first, so that a floor a millimetre below zero reads 0.0, not -0.0.
+  const auto decimetres = [](double z) { return std::round(z * 10.0) / 10.0 + 0.0; };
+  std::snprintf(low, sizeof(low), "z %.1f m", decimetres(colours.low_m));
+  std::snprintf(high, sizeof(high), "%.1f m", decimetres(colours.high_m));
+  return {low, high, height_colour};
+}
+
 void draw_legend(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanStyle& style,
                  const std::vector<PlanPath>& paths, const PlanLegend& legend) {
   cv::Mat image = as_mat(rgba, frame);
   const int sample = 3 * style.text_height;  // the short line that stands for a path
   const int ramp = 8 * style.text_height;
-  char low[32];
-  char high[32];
-  // Rounded first, so that a floor a millimetre below zero reads 0.0, not -0.0.
-  const auto decimetres = [](double z) { return std::round(z * 10.0) / 10.0 + 0.0; };
-  std::snprintf(low, sizeof(low), "z %.1f m", decimetres(legend.colours.low_m));
-  std::snprintf(high, sizeof(high), "%.1f m", decimetres(legend.colours.high_m));
+  const std::string& low = legend.ramp.low;
+  const std::string& high = legend.ramp.high;
 
   int width = text_width(legend.cut, style);
   for (const PlanPath& path : paths)
@@ -169,11 +175,11 @@ void draw_legend(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanS
   put_text(image, legend.cut, left, baseline, style);
   baseline += row_height;
 
-  // The height ramp between its two ends' heights.
+  // The colour ramp between its two ends' texts.
   put_text(image, low, left, baseline, style);
   const int ramp_left = left + text_width(low, style) + style.gap;
   for (int x = 0; x < ramp; ++x) {
-    const std::array<uint8_t, 3> c = height_colour(static_cast<double>(x) / (ramp - 1));
+    const std::array<uint8_t, 3> c = legend.ramp.colour(static_cast<double>(x) / (ramp - 1));
     cv::line(image, cv::Point(ramp_left + x, baseline - style.text_height),
              cv::Point(ramp_left + x, baseline), cv::Scalar(c[0], c[1], c[2], 255));
   }

@@ -17,6 +17,9 @@ constexpr float kStepM = 0.15f;
 /// pixel thin, too faint beside the floor's colours.
 constexpr double kWallLineM = 0.1;
 constexpr double kMinColourSpanM = 1.0;
+/// The light of a wall in a picture coloured per vertex: it comes out a fifth darker than a
+/// level floor.
+constexpr uint8_t kWallLight = 120;
 
 double percentile(std::vector<float> values, double q) {
   const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
@@ -49,6 +52,16 @@ bool on_step(const PlanSurface& surface, const PlanFrame& frame, int column, int
     if (n < h - kStepM) return true;  // false for NaN: the edge of what was seen is no step
   }
   return false;
+}
+
+/// A colour lit by the pixel's light: a flat floor keeps it, slopes towards the light brighten,
+/// away darken.
+void shade_into(const std::array<uint8_t, 3>& colour, uint8_t light, uint8_t* pixel) {
+  const double shade = 0.4 + 0.6 * light / double{PlanSurface::kFlatLight};
+  for (int k = 0; k < 3; ++k) {
+    pixel[k] = static_cast<uint8_t>(
+        std::clamp(std::lround(colour[static_cast<size_t>(k)] * shade), 0L, 255L));
+  }
 }
 
 }  // namespace
@@ -102,15 +115,46 @@ std::vector<uint8_t> shade_plan(const PlanSurface& surface, const PlanFrame& fra
       } else if (on_step(surface, frame, column, row)) {
         std::fill(pixel, pixel + 3, kOutline);
       } else {
-        const std::array<uint8_t, 3> colour =
-            height_colour((h - range.low_m) / (range.high_m - range.low_m));
-        // A flat floor keeps its colour; slopes towards the light brighten, away darken.
-        const double shade = 0.4 + 0.6 * surface.light[i] / double{PlanSurface::kFlatLight};
-        for (int k = 0; k < 3; ++k) {
-          pixel[k] = static_cast<uint8_t>(
-              std::clamp(std::lround(colour[static_cast<size_t>(k)] * shade), 0L, 255L));
-        }
+        shade_into(height_colour((h - range.low_m) / (range.high_m - range.low_m)),
+                   surface.light[i], pixel);
       }
+    }
+  }
+  return rgba;
+}
+
+std::vector<uint8_t> shade_plan_by_vertex(
+    const PlanSurface& surface, const PlanFrame& frame, const mesh::TriangleMesh& mesh,
+    const std::vector<Eigen::Matrix<uint8_t, 3, 1>>& vertex_rgb) {
+  std::vector<uint8_t> rgba(frame.pixels() * 4, 255);
+  for (int row = 0; row < frame.height_px; ++row) {
+    for (int column = 0; column < frame.width_px; ++column) {
+      const size_t i = frame.index(column, row);
+      uint8_t* pixel = &rgba[4 * i];
+      const int32_t t = surface.triangle[i];
+      if (t < 0) {
+        std::fill(pixel, pixel + 3, kEmpty);
+        continue;
+      }
+      const bool wall = surface.is_wall[i] != 0;
+      // A wall's top is a step above the floor beside it: walls keep their own colour.
+      if (!wall && on_step(surface, frame, column, row)) {
+        std::fill(pixel, pixel + 3, kOutline);
+        continue;
+      }
+      // Marching cubes' triangles are about a voxel, a pixel or less: their mean colour is as
+      // fine as the picture.
+      const Eigen::Vector3i& corners = mesh.triangles[static_cast<size_t>(t)];
+      std::array<uint8_t, 3> colour{};
+      for (size_t k = 0; k < 3; ++k) {
+        int sum = 0;
+        for (int c = 0; c < 3; ++c)
+          sum += vertex_rgb[static_cast<size_t>(corners[c])][static_cast<Eigen::Index>(k)];
+        colour[k] = static_cast<uint8_t>((sum + 1) / 3);
+      }
+      // Walls, seen edge on, are drawn a little darker than level (a wall on the reference
+      // is grey beside a white floor); floors and slopes are hill-shaded.
+      shade_into(colour, wall ? kWallLight : surface.light[i], pixel);
     }
   }
   return rgba;

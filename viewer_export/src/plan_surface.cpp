@@ -29,7 +29,7 @@ class Rasterizer {
       : frame_(frame), cut_(cut), out_(out) {}
 
   /// A level or sloping triangle: the pixels whose centres it covers, at its height there.
-  void fill(const Projected& t, uint8_t light) {
+  void fill(const Projected& t, int32_t triangle, uint8_t light) {
     const double area = (t.column[1] - t.column[0]) * (t.row[2] - t.row[0]) -
                         (t.column[2] - t.column[0]) * (t.row[1] - t.row[0]);
     if (std::abs(area) < 1e-12) return;
@@ -52,6 +52,7 @@ class Rasterizer {
           out_.height_m[i] = static_cast<float>(z);
           out_.light[i] = light;
           out_.is_wall[i] = 0;
+          out_.triangle[i] = triangle;
         }
       }
     }
@@ -59,7 +60,7 @@ class Rasterizer {
 
   /// A steep triangle: every pixel its outline passes through (sampled every half pixel along
   /// its edges) and those whose centres it covers, at its top or at the cut.
-  void cover(const Projected& t, uint8_t light) {
+  void cover(const Projected& t, int32_t triangle, uint8_t light) {
     for (int e = 0; e < 3; ++e) {
       const int f = (e + 1) % 3;
       const double length = std::hypot(t.column[f] - t.column[e], t.row[f] - t.row[e]);
@@ -69,7 +70,7 @@ class Rasterizer {
         const double column = t.column[e] + k * (t.column[f] - t.column[e]);
         const double row = t.row[e] + k * (t.row[f] - t.row[e]);
         mark_wall(t, static_cast<int>(std::floor(column)), static_cast<int>(std::floor(row)),
-                  light);
+                  triangle, light);
       }
     }
     const double area = (t.column[1] - t.column[0]) * (t.row[2] - t.row[0]) -
@@ -85,7 +86,7 @@ class Rasterizer {
             ((t.column[1] - x) * (t.row[2] - y) - (t.column[2] - x) * (t.row[1] - y)) / area;
         const double w1 =
             ((t.column[2] - x) * (t.row[0] - y) - (t.column[0] - x) * (t.row[2] - y)) / area;
-        if (w0 >= 0.0 && w1 >= 0.0 && w0 + w1 <= 1.0) mark_wall(t, c, r, light);
+        if (w0 >= 0.0 && w1 >= 0.0 && w0 + w1 <= 1.0) mark_wall(t, c, r, triangle, light);
       }
     }
   }
@@ -108,7 +109,7 @@ class Rasterizer {
     return cut_.at(frame_.x_of(column), frame_.y_of(row));
   }
 
-  void mark_wall(const Projected& t, int column, int row, uint8_t light) {
+  void mark_wall(const Projected& t, int column, int row, int32_t triangle, uint8_t light) {
     if (column < 0 || row < 0 || column >= frame_.width_px || row >= frame_.height_px) return;
     const double cut = cut_at(t, column, row);
     if (t.z_min > cut) return;
@@ -118,6 +119,7 @@ class Rasterizer {
       out_.height_m[i] = z;
       out_.light[i] = light;
       out_.is_wall[i] = 1;
+      out_.triangle[i] = triangle;
     }
   }
 
@@ -134,11 +136,13 @@ PlanSurface rasterize_below_cut(const mesh::TriangleMesh& mesh, const PlanFrame&
   out.height_m.assign(frame.pixels(), std::numeric_limits<float>::quiet_NaN());
   out.light.assign(frame.pixels(), 0);
   out.is_wall.assign(frame.pixels(), 0);
+  out.triangle.assign(frame.pixels(), -1);
   Rasterizer rasterizer(frame, cut, out);
   // From the upper left of the image (north-west) and 45 degrees up, as hill-shaded maps are.
   const Eigen::Vector3d to_light = Eigen::Vector3d(-1.0, 1.0, std::sqrt(2.0)).normalized();
   const bool smooth = mesh.has_normals();
-  for (const Eigen::Vector3i& triangle : mesh.triangles) {
+  for (size_t index = 0; index < mesh.triangles.size(); ++index) {
+    const Eigen::Vector3i& triangle = mesh.triangles[index];
     const Eigen::Vector3f* v[3];
     for (int k = 0; k < 3; ++k) v[k] = &mesh.vertices[static_cast<size_t>(triangle[k])];
     const Eigen::Vector3f face = (*v[1] - *v[0]).cross(*v[2] - *v[0]);
@@ -165,9 +169,9 @@ PlanSurface rasterize_below_cut(const mesh::TriangleMesh& mesh, const PlanFrame&
     const uint8_t light =
         static_cast<uint8_t>(std::lround(255.0 * std::clamp(normal.dot(to_light), 0.0, 1.0)));
     if (std::abs(face.z()) / length < kSteep) {
-      rasterizer.cover(t, light);
+      rasterizer.cover(t, static_cast<int32_t>(index), light);
     } else {
-      rasterizer.fill(t, light);
+      rasterizer.fill(t, static_cast<int32_t>(index), light);
     }
   }
   return out;

@@ -99,9 +99,12 @@ double plan_grid_spacing_m(double extent_m) {
 }
 
 PlanImage render_plan_view(const mesh::TriangleMesh& mesh, const std::vector<PlanPath>& paths,
-                           const PlanViewSettings& settings) {
+                           const PlanViewSettings& settings, const PlanVertexColours* colours) {
   if (mesh.triangles.empty()) throw mesh::MeshError("a plan view needs triangles");
   mesh::validate(mesh, "the plan view's mesh");
+  if (colours != nullptr && (colours->rgb.size() != mesh.vertices.size() || !colours->ramp)) {
+    throw mesh::MeshError("a plan view's colours need one per vertex and a ramp");
+  }
   const std::vector<Eigen::Vector3d> positions = finite_positions(paths);
   PlanFrame frame = frame_around(mesh, positions, settings);
   const PlanStyle style = plan_style(std::max(frame.width_px, frame.height_px));
@@ -113,15 +116,21 @@ PlanImage render_plan_view(const mesh::TriangleMesh& mesh, const std::vector<Pla
   frame.height_px += top_band + bottom_band;
   const CutHeightField cut = choose_cut(mesh, positions, settings, frame);
   PlanSurface surface = rasterize_below_cut(mesh, frame, cut);
-  const HeightRange colours = colour_range(surface);
+  const HeightRange heights = colour_range(surface);
 
   PlanImage image;
-  image.rgba = shade_plan(surface, frame, colours);
+  PlanLegend legend{cut_legend(cut), height_ramp_legend(heights)};
+  if (colours != nullptr) {
+    image.rgba = shade_plan_by_vertex(surface, frame, mesh, colours->rgb);
+    legend.ramp = {colours->low, colours->high, colours->ramp};
+  } else {
+    image.rgba = shade_plan(surface, frame, heights);
+  }
   const double spacing = plan_grid_spacing_m(map_extent_m);
   draw_grid(image.rgba, frame, spacing);
   draw_paths(image.rgba, frame, style, paths);
   draw_scale_bar(image.rgba, frame, style, spacing);
-  draw_legend(image.rgba, frame, style, paths, {cut_legend(cut), colours});
+  draw_legend(image.rgba, frame, style, paths, legend);
   image.surface_height_m = std::move(surface.height_m);
 
   PlanView& view = image.view;
@@ -134,14 +143,15 @@ PlanImage render_plan_view(const mesh::TriangleMesh& mesh, const std::vector<Pla
   view.cut_low_m = cut.lowest_m();
   view.cut_high_m = cut.highest_m();
   view.grid_spacing_m = spacing;
-  view.low_z_m = colours.low_m;
-  view.high_z_m = colours.high_m;
+  view.low_z_m = heights.low_m;
+  view.high_z_m = heights.high_m;
   return image;
 }
 
 PlanView write_plan_view_png(const mesh::TriangleMesh& mesh, const std::vector<PlanPath>& paths,
-                             const std::string& path, const PlanViewSettings& settings) {
-  const PlanImage image = render_plan_view(mesh, paths, settings);
+                             const std::string& path, const PlanViewSettings& settings,
+                             const PlanVertexColours* colours) {
+  const PlanImage image = render_plan_view(mesh, paths, settings, colours);
   write_rgba_png(path, image.rgba, image.view.width_px, image.view.height_px);
   return image.view;
 }

@@ -2,7 +2,9 @@
 // What is drawn over the plan's surfaces: the metric grid, the paths, the scale bar and the
 // legend (OpenCV's imgproc, which the program links for the front end already).
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,9 +31,19 @@ PlanStyle plan_style(int side_px);
 int legend_height_px(const PlanStyle& style, size_t paths);
 int scale_bar_height_px(const PlanStyle& style);
 
+/// The legend's colour ramp: what the surfaces' colours mean.
+struct PlanRampLegend {
+  std::string low;   ///< the text before the ramp, at t = 0 ("z 0.0 m")
+  std::string high;  ///< the text after it, at t = 1
+  std::function<std::array<uint8_t, 3>(double t)> colour;
+};
+
+/// The height ramp between the two heights of `colours`.
+PlanRampLegend height_ramp_legend(const HeightRange& colours);
+
 struct PlanLegend {
   std::string cut;  ///< one line on where the plan was cut
-  HeightRange colours;
+  PlanRampLegend ramp;
 };
 
 /// Lines every `spacing_m` (map frame multiples of it), blended in grey.

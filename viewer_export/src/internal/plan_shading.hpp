@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "featsense/mesh/triangle_mesh.hpp"
 #include "internal/plan_frame.hpp"
 #include "internal/plan_surface.hpp"
 
@@ -27,5 +28,12 @@ std::array<uint8_t, 3> height_colour(double t);
 /// the text read in any viewer.
 std::vector<uint8_t> shade_plan(const PlanSurface& surface, const PlanFrame& frame,
                                 const HeightRange& range);
+
+/// As shade_plan, with each surface in the mean colour of its triangle's vertices
+/// (`vertex_rgb`, one per vertex of `mesh`) instead of its height's. Walls are not widened:
+/// their own colour is what they show, and widening would paint the floor beside them.
+std::vector<uint8_t> shade_plan_by_vertex(
+    const PlanSurface& surface, const PlanFrame& frame, const mesh::TriangleMesh& mesh,
+    const std::vector<Eigen::Matrix<uint8_t, 3, 1>>& vertex_rgb);
 
 }  // namespace featsense::viewer_export

@@ -16,6 +16,9 @@ struct PlanSurface {
   /// 45 degrees up): 0 (away) to 255 (towards it); a flat floor has kFlatLight.
   std::vector<uint8_t> light;
   std::vector<uint8_t> is_wall;  ///< 1 where the surface seen is steep (a wall, an object's side)
+  /// Per pixel, the index of the triangle seen (-1: none), for colours carried by the mesh's
+  /// vertices rather than by heights.
+  std::vector<int32_t> triangle;
   static constexpr uint8_t kFlatLight = 180;
 };
 

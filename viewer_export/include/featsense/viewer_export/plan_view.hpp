@@ -7,6 +7,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +42,15 @@ struct PlanViewSettings {
   double cut_radius_m = 4.0;
 };
 
+/// Colours for the plan's surfaces in place of their heights: one per vertex of the mesh (a
+/// surface takes the mean of its triangle's), with the ramp the legend shows for them.
+struct PlanVertexColours {
+  std::vector<Eigen::Matrix<uint8_t, 3, 1>> rgb;         ///< per vertex (as MeshAttributes::colors)
+  std::string low;                                       ///< the legend's text before the ramp
+  std::string high;                                      ///< and after it
+  std::function<std::array<uint8_t, 3>(double t)> ramp;  ///< t from 0 (low) to 1 (high)
+};
+
 /// What the plan shows and how it was drawn, for reports.
 struct PlanView {
   int width_px = 0;
@@ -63,14 +75,18 @@ struct PlanImage {
 };
 
 /// Draws the plan of `mesh` with `paths` (any number; empty: the cut comes from the mesh's
-/// floors and ceilings alone). Throws mesh::MeshError for a mesh without triangles.
+/// floors and ceilings alone), its surfaces coloured by height, or by `colours` where given
+/// (the same cut, paths, grid and scale bar). Throws mesh::MeshError for a mesh without
+/// triangles, or colours that are not one per vertex.
 PlanImage render_plan_view(const mesh::TriangleMesh& mesh, const std::vector<PlanPath>& paths,
-                           const PlanViewSettings& settings = {});
+                           const PlanViewSettings& settings = {},
+                           const PlanVertexColours* colours = nullptr);
 
 /// render_plan_view, written to `path` as a PNG. Throws mesh::MeshError for a mesh without
 /// triangles, std::runtime_error when the file cannot be written.
 PlanView write_plan_view_png(const mesh::TriangleMesh& mesh, const std::vector<PlanPath>& paths,
-                             const std::string& path, const PlanViewSettings& settings = {});
+                             const std::string& path, const PlanViewSettings& settings = {},
+                             const PlanVertexColours* colours = nullptr);
 
 /// The grid's spacing for a map `extent_m` across: the smallest of 1, 2, 5 x 10^k m that
 /// leaves at most ten cells across (37 m: 5 m, 400 m: 50 m).
