@@ -278,7 +278,7 @@ class BenchLoops {
   /// The corrected poses of every scan added.
   slam::Trajectory finish() {
     if (!closer_.loops().empty()) closer_.optimise();
-    return corrected_path(closer_.correction(), path_, travelled_m_);
+    return corrected();
   }
 
   /// The corrected poses of every scan added, from the graph as it is.
@@ -315,7 +315,7 @@ class BenchLoops {
     if (a && b) {
       const Eigen::Isometry3d error = (a->inverse() * *b).inverse() * claim;
       out["claim_error_m"] = error.translation().norm();
-      out["claim_error_deg"] = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
+      out["claim_error_deg"] = slam::rotation_angle_deg(error.rotation());
     }
     return out;
   }
@@ -358,7 +358,7 @@ class BenchLoops {
       if (!from || !to) continue;
       const Eigen::Isometry3d error = (from->inverse() * *to).inverse() * edge.T_from_to;
       const double m = error.translation().norm();
-      const double deg = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
+      const double deg = slam::rotation_angle_deg(error.rotation());
       worst_m = std::max(worst_m, m);
       worst_deg = std::max(worst_deg, deg);
       if (m > 0.3 || deg > 2.0) ++false_loops;

@@ -7,16 +7,14 @@
 #include <cmath>
 
 #include "featsense/slam/refine/voxel_gaussians.hpp"
+#include "featsense/slam/trajectory/trajectory_metrics.hpp"
 
 namespace featsense::slam::loops {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 /// Neighbouring points' errors are not independent (one surface, one range bias): a fit is
 /// taken to know the pose as well as this many independent points would.
 constexpr double kEffectivePoints = 50.0;
-
-double angle_deg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / kPi; }
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -55,7 +53,8 @@ bool KeyframeSelector::next(const Eigen::Isometry3d& T_map_sensor) {
   travelled_m_ += (T_map_sensor.translation() - last_pose_.translation()).norm();
   last_pose_ = T_map_sensor;
   if (travelled_m_ - keyframe_travelled_m_ < distance_m_ &&
-      angle_deg(keyframe_pose_.rotation().transpose() * T_map_sensor.rotation()) < angle_deg_)
+      rotation_angle_deg(keyframe_pose_.rotation().transpose() * T_map_sensor.rotation()) <
+          angle_deg_)
     return false;
   keyframe_travelled_m_ = travelled_m_;
   keyframe_pose_ = T_map_sensor;
@@ -291,7 +290,7 @@ bool LoopCloser::add_keyframe(int64_t stamp_ns, double travelled_m,
     const Eigen::Isometry3d T_map_query = graph_.pose(candidate.keyframe) * result.T_target_source;
     const Eigen::Isometry3d& estimate = graph_.pose(query);
     if ((T_map_query.translation() - estimate.translation()).norm() > drift_radius_m(query) ||
-        angle_deg(T_map_query.rotation().transpose() * estimate.rotation()) >
+        rotation_angle_deg(T_map_query.rotation().transpose() * estimate.rotation()) >
             drift_radius_deg(query)) {
       reject(LoopRejection::inconsistent);
       continue;
@@ -338,7 +337,8 @@ bool LoopCloser::add_keyframe(int64_t stamp_ns, double travelled_m,
       optimise_timed();
       const Eigen::Isometry3d& after = graph_.pose(query);
       loops_.back().correction_m = (after.translation() - before.translation()).norm();
-      loops_.back().correction_deg = angle_deg(after.rotation() * before.rotation().transpose());
+      loops_.back().correction_deg =
+          rotation_angle_deg(after.rotation() * before.rotation().transpose());
       last_closure_m_ = travelled_m;
       accepted = true;
     }

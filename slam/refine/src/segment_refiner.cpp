@@ -5,14 +5,9 @@
 #include <cmath>
 #include <utility>
 
+#include "featsense/slam/trajectory/trajectory_metrics.hpp"
+
 namespace featsense::slam::refine {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double angle_deg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / kPi; }
-
-}  // namespace
 
 const char* to_string(RefineOutcome outcome) {
   switch (outcome) {
@@ -87,7 +82,7 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::register_stretch(
   // What the correction does at the stretch's end.
   registration.step_m = (poses.back().translation() - guesses.back().translation()).norm();
   registration.step_deg =
-      angle_deg(poses.back().rotation() * guesses.back().rotation().transpose());
+      rotation_angle_deg(poses.back().rotation() * guesses.back().rotation().transpose());
   if (!result.converged) {
     registration.outcome = RefineOutcome::not_converged;
   } else if (registration.step_m > settings_.max_correction_m ||

@@ -33,13 +33,16 @@ namespace {
 class ReplayLocator final : public ScanLocator {
  public:
   ReplayLocator(Trajectory trajectory, ScanMotions motions)
-      : interpolated_(make_given_pose_locator(std::move(trajectory), true)),
+      : at_stamps_(make_given_pose_locator(trajectory, false)),
+        interpolated_(make_given_pose_locator(std::move(trajectory), true)),
         motions_(std::move(motions)) {}
 
   std::optional<ScanPlacement> locate(const Scan& scan, std::string& why) override {
-    std::optional<ScanPlacement> placed = interpolated_->locate(scan, why);
     const std::optional<ScanMotion> kept = motions_.at(scan.stamp_ns);
-    if (!placed || !kept) return placed;
+    if (!kept) return interpolated_->locate(scan, why);
+    // Only the pose at the stamp from the trajectory: the columns follow the kept motion.
+    std::optional<ScanPlacement> placed = at_stamps_->locate(scan, why);
+    if (!placed) return placed;
     const Eigen::Isometry3d at_stamp = placed->T_map_sensor;
     placed->column_T_map_sensor = column_poses(scan, at_stamp, [&](double t) {
       return std::optional<Eigen::Isometry3d>(at_stamp *
@@ -53,7 +56,8 @@ class ReplayLocator final : public ScanLocator {
   }
 
  private:
-  std::unique_ptr<ScanLocator> interpolated_;
+  std::unique_ptr<ScanLocator> at_stamps_;     ///< the poses at the stamps, scans rigid
+  std::unique_ptr<ScanLocator> interpolated_;  ///< for a scan without a kept motion
   ScanMotions motions_;
 };
 

@@ -58,6 +58,10 @@ double rotation_angle_rad(const Eigen::Matrix3d& R) {
   return std::acos(std::clamp(0.5 * (R.trace() - 1.0), -1.0, 1.0));
 }
 
+double rotation_angle_deg(const Eigen::Matrix3d& R) {
+  return rotation_angle_rad(R) * 180.0 / 3.14159265358979323846;
+}
+
 Trajectory apply_similarity(const Trajectory& trajectory, const Similarity& similarity) {
   Trajectory out = trajectory;
   for (Eigen::Isometry3d& T : out.poses) {

@@ -55,6 +55,8 @@ struct TrajectoryEvaluation {
 
 /// The rotation angle of R, radians, in [0, pi].
 double rotation_angle_rad(const Eigen::Matrix3d& R);
+/// The same in degrees.
+double rotation_angle_deg(const Eigen::Matrix3d& R);
 
 /// Applies the similarity to every pose: p' = s R p + t, R' = R R_pose.
 Trajectory apply_similarity(const Trajectory& trajectory, const Similarity& similarity);
