@@ -4,10 +4,20 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bash "$root/scripts/install-deps.sh"
-# The glTF tests run the Khronos validator where node has it; a failed install only skips them.
-if command -v npm >/dev/null && [ ! -d "$root/test/tools/node_modules/gltf-validator" ]; then
-  (cd "$root/test/tools" && npm install --no-audit --no-fund --silent) ||
-    echo "warning: gltf-validator not installed; the glTF validator checks will be skipped"
+# The glTF tests run the Khronos validator, and the browser tests (report.html, the viewer)
+# drive Debian's Chromium with playwright-core, where they can be installed; where either
+# install fails, the tests that need it skip with a message.
+tools="$root/test/tools"
+if command -v npm >/dev/null &&
+  { [ ! -d "$tools/node_modules/gltf-validator" ] || [ ! -d "$tools/node_modules/playwright-core" ]; }; then
+  (cd "$tools" && npm install --no-audit --no-fund --silent) ||
+    echo "warning: npm install in test/tools failed; the glTF validator and browser checks will be skipped"
+fi
+if ! command -v chromium >/dev/null; then
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends chromium ||
+    echo "warning: chromium not installed; the browser tests will be skipped"
 fi
 build="${FEATSENSE_BUILD_DIR:-$root/build}"
 cmake -S "$root" -B "$build" -G Ninja -DFEATSENSE_BUILD_TESTS=ON "$@"
