@@ -265,6 +265,7 @@ class BenchLoops {
     const bool keyframe = selector_.next(placement.T_map_sensor);
     path_.push_back(placement.stamp_ns, placement.T_map_sensor);
     travelled_m_.push_back(selector_.travelled_m());
+    slam::loops::append_in_time_order(&imu_, scan.imu);
     if (!keyframe) return;
     const auto start = Clock::now();
     const std::vector<Eigen::Vector3f> points =
@@ -277,7 +278,8 @@ class BenchLoops {
 
   /// The corrected poses of every scan added.
   slam::Trajectory finish() {
-    if (!closer_.loops().empty()) closer_.optimise();
+    const size_t levelled = closer_.add_gravity(path_.stamps_ns, path_.poses, imu_);
+    if (!closer_.loops().empty() || levelled > 0) gravity_ = closer_.optimise().gravity;
     return corrected();
   }
 
@@ -344,7 +346,14 @@ class BenchLoops {
                           {"optimise", timing_json(counts.optimise_ms)},
                           // The loop closure's time against the recording's: above 1 it
                           // keeps up with the sensor on one core.
-                          {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)}};
+                          {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)},
+                          {"gravity_observations", gravity_.observations}};
+    if (gravity_.observations > 0) {
+      out["gravity_map_tilt_deg"] = {gravity_.map_tilt_deg.x(), gravity_.map_tilt_deg.y()};
+      out["gravity_accel_bias_mps2"] = {gravity_.accel_bias_mps2.x(), gravity_.accel_bias_mps2.y(),
+                                        gravity_.accel_bias_mps2.z()};
+      out["gravity_rms_whitened"] = gravity_.rms_whitened;
+    }
     if (!truth) return out;
     size_t false_loops = 0;
     double worst_m = 0.0, worst_deg = 0.0;
@@ -385,6 +394,8 @@ class BenchLoops {
   std::vector<double> travelled_m_;
   std::vector<double> cloud_ms_;
   std::vector<int64_t> keyframe_stamps_ns_;
+  std::vector<slam::ImuSample> imu_;  ///< every scan's, in order
+  slam::loops::GravityEstimate gravity_;
 };
 
 /// The trajectory's error against the truth, as JSON (nothing where it is undetermined).

@@ -220,9 +220,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                    {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite});
   const PipelineResult first = pass.result;  // the odometry's poses, before the loops
   const std::optional<LoopOutcome>& loops = first.loops;
-  std::string second_pass = "no loop closed";
+  std::string second_pass = "no loop closed, no gravity";
   std::optional<PipelineResult> second;
-  if (loops && !loops->loops.empty()) {
+  if (loops && loops->corrects_poses()) {
     if (first.interrupted) {
       second_pass = "interrupted: the map keeps the odometry's poses";
     } else if (options.poses_only) {
@@ -232,8 +232,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     } else {
       // The recording again, with the corrected poses, into a new file that replaces the
       // first map only once it is complete.
-      spdlog::info("{} loops closed: mapping the recording again with the corrected poses",
-                   loops->loops.size());
+      spdlog::info("{} loops closed{}: mapping the recording again with the corrected poses",
+                   loops->loops.size(),
+                   loops->gravity.observations > 0 ? ", levelled by gravity" : "");
       const fs::path replay_path = out / "map.corrected.h5";
       std::optional<MapPassOutput> replayed;
       try {
@@ -271,7 +272,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   // The poses the map was made with; with loops closed and no second pass, the corrected ones
   // all the same (to map later with --gt).
   const slam::Trajectory& final_poses =
-      loops && !loops->loops.empty() && !second ? loops->corrected : result.poses;
+      loops && loops->corrects_poses() && !second ? loops->corrected : result.poses;
   slam::write_tum(final_poses, (out / "trajectory.tum").string());
   slam::write_kitti(final_poses, (out / "trajectory.kitti").string());
 
@@ -322,7 +323,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       if (odometry && spans_a_plane(final_poses, kMinAlignmentSpreadM))
         T_truth_estimate = final_evaluation.alignment.T;
       // The front end's own poses too, to show what the loops and the refinement changed.
-      if (loops && !loops->loops.empty())
+      if (loops && loops->corrects_poses())
         report["eval"]["traj_before_loops"] = evaluate(first.poses);
       if (first.unrefined_poses && first.unrefined_poses->size() >= 2)
         report["eval"]["traj_unrefined"] = evaluate(*first.unrefined_poses);

@@ -81,6 +81,14 @@ nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms) {
          {"correction_deg", loop.correction_deg},
          {"weight", loop.weight}});
   }
+  const slam::loops::GravityEstimate& gravity = outcome.gravity;
+  nlohmann::json gravity_json = {{"observations", gravity.observations}};
+  if (gravity.observations > 0) {
+    gravity_json["map_tilt_deg"] = {gravity.map_tilt_deg.x(), gravity.map_tilt_deg.y()};
+    gravity_json["accel_bias_mps2"] = {gravity.accel_bias_mps2.x(), gravity.accel_bias_mps2.y(),
+                                       gravity.accel_bias_mps2.z()};
+    gravity_json["rms_whitened"] = gravity.rms_whitened;
+  }
   return {{"keyframes", counts.keyframes},
           {"candidates", counts.candidates},
           {"verified", counts.verified},
@@ -90,6 +98,7 @@ nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms) {
           {"max_scan_correction_m", outcome.corrections_max_m},
           {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
           {"loops", list},
+          {"gravity", gravity_json},
           {"timings",
            {{"keyframe", timing_json(counts.keyframe_ms)},
             {"optimise", timing_json(counts.optimise_ms)},

@@ -49,6 +49,7 @@ bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placeme
   const bool keyframe = selector_.next(placement.T_map_sensor);
   path_.push_back(placement.stamp_ns, placement.T_map_sensor);
   travelled_m_.push_back(selector_.travelled_m());
+  slam::loops::append_in_time_order(&imu_, scan.imu);
   if (!keyframe) return true;
   KeyframeJob job;
   job.stamp_ns = placement.stamp_ns;
@@ -69,7 +70,10 @@ LoopOutcome LoopStage::finish() {
   if (worker_.joinable()) worker_.join();
   if (failure_) std::rethrow_exception(failure_);
   LoopOutcome out;
-  if (!closer_.loops().empty()) out.final_optimisation = closer_.optimise();
+  // The loop thread is done with the closer: the gravity goes in from here.
+  const size_t levelled = closer_.add_gravity(path_.stamps_ns, path_.poses, imu_);
+  if (!closer_.loops().empty() || levelled > 0) out.final_optimisation = closer_.optimise();
+  out.gravity = out.final_optimisation.gravity;
   out.loops = closer_.loops();
   out.counts = closer_.counts();
   out.keyframe_queue_wait_ms = wait_ms_;

@@ -2,8 +2,8 @@
 // Loop closure as a stage of the mapping pipeline: every scan whose pose is final passes
 // through offer() (from the rays thread); a keyframe's points go to a thread of its own, where
 // the loop closer searches, verifies and optimises, so that the pipeline does not wait for it
-// unless it falls a few keyframes behind. At the end the corrections of the keyframes are
-// spread over every scan's pose.
+// unless it falls a few keyframes behind. At the end, where the input had an IMU, its gravity
+// levels the graph too, and the corrections of the keyframes are spread over every scan's pose.
 
 #include <exception>
 #include <memory>
@@ -27,6 +27,11 @@ struct LoopOutcome {
   slam::Trajectory corrected;
   double corrections_max_m = 0.0;       ///< the largest move of a scan's position
   double keyframe_queue_wait_ms = 0.0;  ///< the pipeline's wait for the loop thread, in all
+  /// Where the input had an IMU: gravity levelled the graph (observations > 0).
+  slam::loops::GravityEstimate gravity;
+  /// Whether the corrected poses differ from those the map was made with: loops were closed
+  /// or gravity levelled the path.
+  bool corrects_poses() const { return !loops.empty() || gravity.observations > 0; }
 };
 
 /// Every pose of `path` (pose i taken `travelled_m[i]` metres along it) moved by the
@@ -66,6 +71,7 @@ class LoopStage {
   std::exception_ptr failure_;
   slam::Trajectory path_;
   std::vector<double> travelled_m_;
+  std::vector<slam::ImuSample> imu_;  ///< every scan's, in order
   double wait_ms_ = 0.0;
   std::thread worker_;  ///< last: it starts once everything it uses is there
 };

@@ -275,6 +275,8 @@ std::vector<KeySpec> make_specs() {
       number_key("loop.max_fitness", &Config::loop, &LoopConfig::max_fitness_m, {0.0, 10.0, true}),
       number_key("loop.min_inliers", &Config::loop, &LoopConfig::min_inlier_fraction, {0.0, 1.0}),
       number_key("loop.drift", &Config::loop, &LoopConfig::drift, {0.0, 1.0}),
+      bool_key("loop.gravity", &Config::loop, &LoopConfig::gravity),
+      number_key("loop.gravity_window", &Config::loop, &LoopConfig::gravity_window_s, {0.5, 60.0}),
   };
 }
 

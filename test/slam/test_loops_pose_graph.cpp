@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -14,6 +15,8 @@ namespace featsense::slam::loops {
 namespace {
 
 using test::pose;
+
+constexpr double kDegree = M_PI / 180.0;
 
 /// Twice round a 20 x 20 m square, a node every metre, and an odometry that drifts: 0.1 deg of
 /// yaw and 1 cm sideways per metre, with a little noise.
@@ -140,6 +143,120 @@ TEST(PoseGraph, RejectsBadEdges) {
                std::invalid_argument);
   // A graph without edges optimises to itself.
   EXPECT_TRUE(graph.optimize().converged);
+}
+
+/// Twice round a 20 x 20 m square whose odometry tilts: 0.02 deg of pitch and 0.01 deg of roll
+/// per metre (a path that bends up), and an IMU's up direction at each node, with an
+/// accelerometer bias `bias` in the sensor frame. The odometry starts in a frame tilted by
+/// `frame_tilt` from the vertical (`truth` is in it too, `level_truth` is not).
+struct TiltingSquare {
+  std::vector<Eigen::Isometry3d> level_truth;
+  std::vector<Eigen::Isometry3d> truth;
+  std::vector<Eigen::Isometry3d> odometry;
+  std::vector<GravityObservation> gravity;
+
+  TiltingSquare(const Eigen::Vector3d& bias, const Eigen::Isometry3d& frame_tilt) {
+    const DriftingSquare square;
+    level_truth = square.truth;
+    for (const Eigen::Isometry3d& T : square.truth) truth.push_back(frame_tilt * T);
+    odometry.push_back(truth.front());
+    const Eigen::Isometry3d drift = pose(0.0, 0.02 * kDegree, 0.01 * kDegree, {0, 0, 0});
+    for (size_t i = 1; i < truth.size(); ++i)
+      odometry.push_back(odometry.back() * truth[i - 1].inverse() * truth[i] * drift);
+    for (size_t i = 0; i < truth.size(); ++i) {
+      GravityObservation o;
+      o.node = i;
+      // Gravity is vertical in the untilted frame: R_world_sensor^T (g up) + bias.
+      const Eigen::Matrix3d R_world_sensor =
+          frame_tilt.rotation().transpose() * truth[i].rotation();
+      o.mean_force = R_world_sensor.transpose() * Eigen::Vector3d(0, 0, 9.81) + bias;
+      o.sigma_rad = 0.005 * kDegree;
+      gravity.push_back(o);
+    }
+  }
+
+  PoseGraph graph(bool with_gravity) const {
+    PoseGraph g;
+    for (const Eigen::Isometry3d& T : odometry) g.add_node(T);
+    for (size_t i = 1; i < odometry.size(); ++i) {
+      g.add_edge(
+          {i - 1, i, odometry[i - 1].inverse() * odometry[i], information(0.001, 0.01), false});
+    }
+    if (with_gravity) {
+      for (const GravityObservation& o : gravity) g.add_gravity(o, 0.2);
+    }
+    return g;
+  }
+
+  /// The largest tilt of a node from its true attitude in the vertical frame, degrees (the
+  /// angle between the true and the estimated up directions).
+  double worst_tilt_deg(const std::vector<Eigen::Isometry3d>& poses) const {
+    double worst = 0.0;
+    for (size_t i = 0; i < truth.size(); ++i) {
+      const Eigen::Vector3d up_true =
+          level_truth[i].rotation().transpose() * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d up = poses[i].rotation().transpose() * Eigen::Vector3d::UnitZ();
+      worst = std::max(worst, std::acos(std::clamp(up.dot(up_true), -1.0, 1.0)) / kDegree);
+    }
+    return worst;
+  }
+};
+
+TEST(PoseGraph, GravityLevelsAnOdometryThatTilts) {
+  const TiltingSquare square(Eigen::Vector3d::Zero(), Eigen::Isometry3d::Identity());
+  PoseGraph without = square.graph(false);
+  without.optimize();
+  PoseGraph with = square.graph(true);
+  const PoseGraphSummary summary = with.optimize();
+  // The drift turns with the path round the square: up to 0.6 deg.
+  EXPECT_GT(square.worst_tilt_deg(without.poses()), 0.3);
+  EXPECT_LT(square.worst_tilt_deg(with.poses()), 0.02);
+  EXPECT_EQ(summary.gravity.observations, square.truth.size());
+  // The first node was level: the graph levelled the map by no more than its drift allows.
+  EXPECT_LT(summary.gravity.map_tilt_deg.norm(), 0.02);
+}
+
+TEST(PoseGraph, GravityFindsTheAccelerometersBiasOnceThePathTurns) {
+  const Eigen::Vector3d bias(0.15, -0.1, 0.0);
+  const TiltingSquare square(bias, Eigen::Isometry3d::Identity());
+  PoseGraph graph = square.graph(true);
+  const PoseGraphSummary summary = graph.optimize();
+  // A bias of 0.18 m/s^2 read as gravity would lean every node by about 1 degree.
+  EXPECT_LT((summary.gravity.accel_bias_mps2 - bias).head<2>().norm(), 0.005);
+  EXPECT_LT(square.worst_tilt_deg(graph.poses()), 0.03);
+}
+
+TEST(PoseGraph, GravityTellsTheMapFramesTilt) {
+  // The first node, held fixed, stands 1.5 degrees off the vertical (the map frame is the
+  // first scan's): the graph finds the tilt and levels the poses, the first node's position
+  // and heading kept.
+  const Eigen::Isometry3d tilt = pose(0.0, 1.5 * kDegree, 0.0, {0, 0, 0});
+  const TiltingSquare square(Eigen::Vector3d::Zero(), tilt);
+  PoseGraph graph = square.graph(true);
+  const PoseGraphSummary summary = graph.optimize();
+  EXPECT_NEAR(summary.gravity.map_tilt_deg.norm(), 1.5, 0.02);
+  EXPECT_LT(square.worst_tilt_deg(graph.poses()), 0.02);
+  EXPECT_LT((graph.pose(0).translation() - square.truth[0].translation()).norm(), 1e-9);
+  const Eigen::Vector3d heading = graph.pose(0).rotation() * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d heading_true = square.truth[0].rotation() * Eigen::Vector3d::UnitX();
+  EXPECT_NEAR(std::atan2(heading.y(), heading.x()), std::atan2(heading_true.y(), heading_true.x()),
+              1e-3);
+}
+
+TEST(PoseGraph, RejectsBadGravity) {
+  PoseGraph graph;
+  graph.add_node(Eigen::Isometry3d::Identity());
+  GravityObservation o;
+  o.mean_force = Eigen::Vector3d(0, 0, 9.81);
+  o.sigma_rad = 0.001;
+  o.node = 1;
+  EXPECT_THROW(graph.add_gravity(o, 0.2), std::invalid_argument);
+  o.node = 0;
+  o.sigma_rad = 0.0;
+  EXPECT_THROW(graph.add_gravity(o, 0.2), std::invalid_argument);
+  o.sigma_rad = 0.001;
+  o.mean_force = Eigen::Vector3d(NAN, 0, 9.81);
+  EXPECT_THROW(graph.add_gravity(o, 0.2), std::invalid_argument);
 }
 
 TEST(TrajectoryCorrection, IsContinuousAndExactAtKeyframes) {

@@ -71,6 +71,8 @@ LoopSettings from_config(const config::Config& config) {
   settings.max_fitness_m = config.loop.max_fitness_m;
   settings.min_inlier_fraction = config.loop.min_inlier_fraction;
   settings.drift_per_m = config.loop.drift;
+  settings.gravity.enabled = config.loop.gravity;
+  settings.gravity.window_s = config.loop.gravity_window_s;
   return settings;
 }
 
@@ -368,6 +370,19 @@ void LoopCloser::add_loop_edge(size_t candidate, size_t query,
 }
 
 PoseGraphSummary LoopCloser::optimise() { return optimise_timed(); }
+
+size_t LoopCloser::add_gravity(const std::vector<int64_t>& path_stamps_ns,
+                               const std::vector<Eigen::Isometry3d>& path,
+                               const std::vector<ImuSample>& samples) {
+  std::vector<int64_t> keyframe_stamps_ns;
+  keyframe_stamps_ns.reserve(keyframes_.size());
+  for (const Keyframe& keyframe : keyframes_) keyframe_stamps_ns.push_back(keyframe.stamp_ns);
+  const std::vector<GravityObservation> observations =
+      gravity_observations(path_stamps_ns, path, samples, keyframe_stamps_ns, settings_.gravity);
+  for (const GravityObservation& observation : observations)
+    graph_.add_gravity(observation, settings_.gravity.bias_prior_mps2);
+  return observations.size();
+}
 
 TrajectoryCorrection LoopCloser::correction() const {
   TrajectoryCorrection out;

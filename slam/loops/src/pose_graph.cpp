@@ -49,6 +49,72 @@ class RelativePoseCost {
   Matrix6d sqrt_information_;
 };
 
+/// Two directions across the mean up direction of the sensor frame: the accelerometer's bias
+/// along up only changes gravity's length, which the observations do not use.
+using BiasBasis = Eigen::Matrix<double, 3, 2>;
+
+BiasBasis bias_basis(const std::vector<GravityObservation>& observations) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const GravityObservation& o : observations) up += o.up().normalized();
+  up = up.norm() > 0.0 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d helper =
+      std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  BiasBasis basis;
+  basis.col(0) = up.cross(helper).normalized();
+  basis.col(1) = up.cross(basis.col(0));
+  return basis;
+}
+
+/// A gravity observation's error: the node's up vector (the observation's, less the bias)
+/// turned into the vertical frame (the map frame tilted back) should point along +Z; its x and
+/// y components over its length, whitened, are the residual (radians for small tilts). The
+/// length is the observation's without bias, a constant: divided by the vector's own length,
+/// a bias along up would shorten every residual by lengthening the vector.
+class GravityCost {
+ public:
+  /// The bias is bias_basis x (two coordinates): the part along up only scales the vector.
+  GravityCost(const GravityObservation& observation, const BiasBasis& bias_basis)
+      : o_(observation), basis_(bias_basis), length_(observation.up().norm()) {}
+
+  template <typename T>
+  bool operator()(const T* q_node, const T* map_tilt, const T* bias, T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Eigen::Quaternion<T>> r_node(q_node);
+    const Vector3 b = basis_.template cast<T>() * Eigen::Map<const Eigen::Matrix<T, 2, 1>>(bias);
+    const Vector3 up_node =
+        (o_.mean_force.template cast<T>() - o_.bias_rotation.template cast<T>() * b -
+         o_.velocity_change.template cast<T>()) /
+        length_;
+    const Vector3 up_map = r_node * up_node;
+    const T tilt[3] = {map_tilt[0], map_tilt[1], T(0)};
+    T up_vertical[3];
+    ceres::AngleAxisRotatePoint(tilt, up_map.data(), up_vertical);
+    residual[0] = up_vertical[0] / o_.sigma_rad;
+    residual[1] = up_vertical[1] / o_.sigma_rad;
+    return true;
+  }
+
+ private:
+  GravityObservation o_;
+  BiasBasis basis_;
+  double length_;
+};
+
+/// A weak prior on the accelerometer's bias, for paths that never turn (it is unobservable
+/// from a tilt of the whole map then).
+class BiasPriorCost {
+ public:
+  explicit BiasPriorCost(double sigma) : sigma_(sigma) {}
+  template <typename T>
+  bool operator()(const T* bias, T* residual) const {
+    for (int i = 0; i < 2; ++i) residual[i] = bias[i] / sigma_;
+    return true;
+  }
+
+ private:
+  double sigma_;
+};
+
 /// U with U^T U = information.
 Matrix6d square_root(const Matrix6d& information) {
   const Eigen::LLT<Matrix6d> llt(information);
@@ -87,6 +153,18 @@ void PoseGraph::add_edge(const PoseGraphEdge& edge) {
     throw std::invalid_argument("pose graph: an edge's information is not symmetric");
   square_root(edge.information);  // throws where it is not positive definite
   edges_.push_back(edge);
+}
+
+void PoseGraph::add_gravity(const GravityObservation& observation, double bias_prior_mps2) {
+  if (observation.node >= poses_.size())
+    throw std::invalid_argument("pose graph: a gravity observation of node " +
+                                std::to_string(observation.node) + " of " +
+                                std::to_string(poses_.size()));
+  if (!(observation.sigma_rad > 0.0) || !std::isfinite(observation.sigma_rad) ||
+      !(bias_prior_mps2 > 0.0) || !observation.up().allFinite() || observation.up().norm() == 0.0)
+    throw std::invalid_argument("pose graph: a gravity observation without a direction or sigma");
+  gravity_.push_back(observation);
+  bias_prior_mps2_ = bias_prior_mps2;
 }
 
 double PoseGraph::whitened_error(const PoseGraphEdge& edge) const {
@@ -135,6 +213,21 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
                              rotations[edge.to].coeffs().data());
   }
 
+  const BiasBasis basis = bias_basis(gravity_);
+  Eigen::Vector2d bias_coordinates = basis.transpose() * accel_bias_;
+  for (const GravityObservation& observation : gravity_) {
+    // Huber: a window spoilt by a jolt the odometry's velocities missed pulls, but only so far.
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GravityCost, 2, 4, 2, 2>(
+                                 new GravityCost(observation, basis)),
+                             new ceres::HuberLoss(3.0), rotations[observation.node].coeffs().data(),
+                             map_tilt_rad_.data(), bias_coordinates.data());
+  }
+  if (!gravity_.empty()) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<BiasPriorCost, 2, 2>(new BiasPriorCost(bias_prior_mps2_)),
+        nullptr, bias_coordinates.data());
+  }
+
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = settings.max_iterations_per_solve;
@@ -160,11 +253,40 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
     for (ceres::LossFunctionWrapper* loss : loop_losses)
       loss->Reset(new ceres::CauchyLoss(scale), ceres::TAKE_OWNERSHIP);
   }
+  // With gravity, the poses go into the vertical frame: the map frame tilted back by what the
+  // observations of every node say (the first node alone, held fixed, would decide it else).
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  if (!gravity_.empty()) {
+    const Eigen::Vector3d axis(map_tilt_rad_.x(), map_tilt_rad_.y(), 0.0);
+    if (axis.norm() > 0.0) {
+      // About the first node: it keeps its position.
+      level.linear() = Eigen::AngleAxisd(axis.norm(), axis.normalized()).toRotationMatrix();
+      level.translation() = translations[0] - level.linear() * translations[0];
+    }
+  }
   for (size_t i = 0; i < poses_.size(); ++i) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = rotations[i].normalized().toRotationMatrix();
     pose.translation() = translations[i];
-    poses_[i] = pose;
+    poses_[i] = level * pose;
+  }
+  if (!gravity_.empty()) {
+    // The residuals with the tilt they were solved with, before the frame is levelled.
+    GravityEstimate& gravity = summary.gravity;
+    gravity.observations = gravity_.size();
+    gravity.map_tilt_deg = map_tilt_rad_ * (180.0 / 3.14159265358979323846);
+    accel_bias_ = basis * bias_coordinates;
+    gravity.accel_bias_mps2 = accel_bias_;
+    double sum = 0.0;
+    for (const GravityObservation& observation : gravity_) {
+      double residual[2];
+      const double* q = rotations[observation.node].coeffs().data();
+      const GravityCost cost(observation, basis);
+      cost(q, map_tilt_rad_.data(), bias_coordinates.data(), residual);
+      sum += residual[0] * residual[0] + residual[1] * residual[1];
+    }
+    gravity.rms_whitened = std::sqrt(sum / (2.0 * static_cast<double>(gravity_.size())));
+    map_tilt_rad_.setZero();  // the poses are levelled: the next solve starts from level
   }
   for (const PoseGraphEdge& edge : edges_) {
     if (!edge.loop) continue;

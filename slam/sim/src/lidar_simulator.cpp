@@ -63,6 +63,8 @@ SimulatedFrame LidarSimulator::simulate(uint64_t index) const {
   scan.sequence = index;
   scan.stamp_ns =
       settings_.start_stamp_ns + static_cast<int64_t>(std::llround(frame.start_s * 1e9));
+  scan.imu = simulate_imu(trajectory_, settings_.imu, m.seed, frame.start_s,
+                          frame.start_s + period_s, settings_.start_stamp_ns);
 
   // Rays in the map frame, each column from the pose at its own firing time.
   std::vector<Ray> rays(rows * cols);

@@ -107,6 +107,8 @@ struct LoopConfig {
   double max_fitness_m = 0.12;
   double min_inlier_fraction = 0.55;
   double drift = 0.02;
+  bool gravity = true;
+  double gravity_window_s = 4.0;
 };
 
 struct Config {

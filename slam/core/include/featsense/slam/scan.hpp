@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "featsense/slam/imu_sample.hpp"
+
 namespace featsense::slam {
 
 /// A per-point channel of a scan by name: "intensity", "reflectivity", "signal", "nir",
@@ -49,6 +51,9 @@ struct Scan {
   std::vector<float> time_offset_s;
   std::vector<uint8_t> valid;  ///< 1 where the cell holds a return
   std::vector<ScanChannel> channels;
+  /// The IMU's samples taken during this sweep, in the sensor frame and time order; empty
+  /// where the source has no IMU.
+  std::vector<ImuSample> imu;
 
   /// A scan of rows x cols with every cell invalid and no channels.
   static Scan allocate(int rows, int cols);

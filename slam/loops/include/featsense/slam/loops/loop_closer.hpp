@@ -26,6 +26,7 @@
 
 #include "featsense/config/config.hpp"
 #include "featsense/slam/loops/compact_cloud.hpp"
+#include "featsense/slam/loops/gravity_reference.hpp"
 #include "featsense/slam/loops/pose_graph.hpp"
 #include "featsense/slam/loops/scan_context.hpp"
 #include "featsense/slam/loops/trajectory_correction.hpp"
@@ -77,6 +78,8 @@ struct LoopSettings {
   double min_sigma_m = 0.01;
   double min_sigma_rad = 1e-3;
   PoseGraphSettings graph;
+  /// The IMU's gravity as the graph's vertical reference (gravity_reference.hpp).
+  GravitySettings gravity;
 };
 
 /// loop.* of `config`.
@@ -148,7 +151,15 @@ class LoopCloser {
   void add_loop_edge(size_t candidate, size_t query, const Eigen::Isometry3d& T_candidate_query,
                      const Matrix6d& information);
 
-  /// Optimises the graph with every loop (at the end of a run).
+  /// The gravity the IMU's `samples` (time order) saw around each keyframe, with the rotations
+  /// and velocities of the front end's `path` (every scan's stamp and pose, stamps increasing),
+  /// for the next optimisations. Returns how many keyframes got an observation (none without
+  /// samples or with loop.gravity off).
+  size_t add_gravity(const std::vector<int64_t>& path_stamps_ns,
+                     const std::vector<Eigen::Isometry3d>& path,
+                     const std::vector<ImuSample>& samples);
+
+  /// Optimises the graph with every loop and gravity observation (at the end of a run).
   PoseGraphSummary optimise();
 
   /// The correction of the poses between keyframes, from the graph's current poses.

@@ -4,12 +4,19 @@
 /// are trusted as measured; loop edges go through a Cauchy loss whose scale shrinks over a few
 /// solves (graduated non-convexity): at first every loop pulls, and a loop that disagrees with
 /// the others and with the odometry ends with a weight near 0 instead of bending the map.
+/// Where an IMU saw gravity (gravity_reference.hpp), each observation pulls its node's up
+/// direction to the vertical; two more variables take what the map frame (the first node,
+/// held fixed) is tilted from the vertical, and the accelerometer's bias. The solved poses are
+/// then turned into the vertical frame (Z up, the first node's position and heading kept):
+/// the map is level with gravity, whatever the first scan's tilt.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include <cstddef>
 #include <vector>
+
+#include "featsense/slam/loops/gravity_reference.hpp"
 
 namespace featsense::slam::loops {
 
@@ -36,6 +43,19 @@ struct PoseGraphSettings {
   int max_iterations_per_solve = 50;
 };
 
+/// What the gravity observations told, after a solve.
+struct GravityEstimate {
+  size_t observations = 0;
+  /// How far the front end's map frame (the first node's) was tilted from the vertical, about
+  /// its x and y axes, degrees: the rotation the poses were levelled by.
+  Eigen::Vector2d map_tilt_deg = Eigen::Vector2d::Zero();
+  /// The accelerometer's bias across the up direction (along it, it is not observable).
+  Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  /// The root mean square of the observations' whitened errors (about 1 when the model's
+  /// noise is right).
+  double rms_whitened = 0.0;
+};
+
 struct PoseGraphSummary {
   int solves = 0;
   int iterations = 0;
@@ -46,6 +66,7 @@ struct PoseGraphSummary {
   /// gave it (1: obeyed, near 0: rejected by the graph).
   std::vector<double> loop_chi;
   std::vector<double> loop_weights;
+  GravityEstimate gravity;
 };
 
 class PoseGraph {
@@ -55,6 +76,8 @@ class PoseGraph {
   /// Throws std::invalid_argument for a node index out of range, a self edge or an
   /// information matrix that is not symmetric positive definite.
   void add_edge(const PoseGraphEdge& edge);
+  /// Throws std::invalid_argument for a node out of range or a sigma that is not positive.
+  void add_gravity(const GravityObservation& observation, double bias_prior_mps2);
   PoseGraphSummary optimize(const PoseGraphSettings& settings = {});
 
   size_t size() const { return poses_.size(); }
@@ -68,6 +91,11 @@ class PoseGraph {
  private:
   std::vector<Eigen::Isometry3d> poses_;
   std::vector<PoseGraphEdge> edges_;
+  std::vector<GravityObservation> gravity_;
+  double bias_prior_mps2_ = 0.2;
+  /// The map frame's tilt (angle-axis about x and y) and the bias, kept between solves.
+  Eigen::Vector2d map_tilt_rad_ = Eigen::Vector2d::Zero();
+  Eigen::Vector3d accel_bias_ = Eigen::Vector3d::Zero();
 };
 
 /// The error of an edge measured as T_from_to between poses at `T_map_from` and `T_map_to`, in

@@ -10,6 +10,7 @@
 
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/slam/scan.hpp"
+#include "featsense/slam/sim/imu_simulator.hpp"
 #include "featsense/slam/sim/measurement_model.hpp"
 #include "featsense/slam/sim/ray_caster.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
@@ -19,13 +20,17 @@ namespace featsense::slam {
 struct SimulationSettings {
   config::SensorModel sensor;
   MeasurementSettings measurement;
+  /// The IMU riding with the LiDAR (its samples go with each frame); its noise draws use
+  /// measurement.seed.
+  ImuModel imu;
   int64_t start_stamp_ns = 1'700'000'000'000'000'000;  ///< stamp of frame 0
 };
 
 /// One simulated revolution.
 struct SimulatedFrame {
   /// Sensor frame at each column's own time; channels "reflectivity" (0..100 %) and
-  /// "intensity"; range_m measured from the lidar origin (beam origin offset included).
+  /// "intensity"; range_m measured from the lidar origin (beam origin offset included); the
+  /// IMU's samples during the revolution.
   Scan scan;
   double start_s = 0.0;  ///< trajectory time of column 0, seconds
   /// Noise-free surface points that the valid returns came from (map frame, metres).

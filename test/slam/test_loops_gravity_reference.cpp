@@ -1,0 +1,129 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/test_poses.hpp"
+#include "featsense/slam/loops/gravity_reference.hpp"
+#include "featsense/slam/sim/imu_simulator.hpp"
+#include "featsense/slam/sim/trajectory.hpp"
+
+namespace featsense::slam::loops {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/// A drive through an S-bend that climbs, speeding up and turning: accelerations of about
+/// 1 m/s^2 that an accelerometer mistakes for a tilt of several degrees.
+struct Drive {
+  std::unique_ptr<PoseCurve> curve;
+  std::vector<int64_t> stamps_ns;  ///< a scan every 0.1 s
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<ImuSample> imu;
+
+  explicit Drive(const ImuModel& model) {
+    curve = make_spline_trajectory(
+        {{0, 0, 0}, {20, 2, 0.5}, {40, 15, 1.5}, {45, 35, 2.0}, {70, 45, 2.5}, {90, 40, 3.0}}, 6.0,
+        true);
+    for (double t = 0.0; t <= curve->duration_s(); t += 0.1) {
+      stamps_ns.push_back(static_cast<int64_t>(std::llround(t * 1e9)));
+      poses.push_back(curve->pose(t));
+    }
+    imu = simulate_imu(*curve, model, 3, 0.0, curve->duration_s(), 0);
+  }
+
+  /// The keyframes: every tenth scan.
+  std::vector<int64_t> keyframes() const {
+    std::vector<int64_t> out;
+    for (size_t i = 0; i < stamps_ns.size(); i += 10) out.push_back(stamps_ns[i]);
+    return out;
+  }
+};
+
+/// The angle between a keyframe's observed up, put in the map by `T`, and +Z, degrees.
+double tilt_deg(const GravityObservation& o, const Eigen::Isometry3d& T,
+                const Eigen::Vector3d& bias = Eigen::Vector3d::Zero()) {
+  const Eigen::Vector3d up = T.rotation() * o.up(bias).normalized();
+  return std::acos(std::clamp(up.z(), -1.0, 1.0)) / kDeg;
+}
+
+TEST(GravityReference, TheAccelerationTheOdometryMeasuredLeavesTheUpDirection) {
+  const Drive drive(ImuModel::exact());
+  const std::vector<int64_t> keyframes = drive.keyframes();
+  const std::vector<GravityObservation> observations =
+      gravity_observations(drive.stamps_ns, drive.poses, drive.imu, keyframes, {});
+  ASSERT_EQ(observations.size(), keyframes.size());
+  double worst = 0.0, worst_raw = 0.0;
+  for (const GravityObservation& o : observations) {
+    const Eigen::Isometry3d T = drive.poses[o.node * 10];
+    worst = std::max(worst, tilt_deg(o, T));
+    // Without the velocity change, the acceleration reads as a tilt.
+    GravityObservation raw = o;
+    raw.velocity_change.setZero();
+    worst_raw = std::max(worst_raw, tilt_deg(raw, T));
+    EXPECT_GT(o.sigma_rad, 0.0);
+  }
+  EXPECT_LT(worst, 0.01);
+  EXPECT_GT(worst_raw, 0.5);
+}
+
+TEST(GravityReference, ATiltedMapFrameShowsAsTheSameTiltOfEveryKeyframe) {
+  // The odometry's whole path tilted by 2 degrees (the first scan's tilt kept as the map's):
+  // the observations, made of relative rotations only, are the same; put in the tilted map
+  // they all lean by the tilt.
+  const Drive drive(ImuModel::exact());
+  const Eigen::Isometry3d tilt = test::pose(0.0, 2.0 * kDeg, 0.0, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Isometry3d> tilted;
+  for (const Eigen::Isometry3d& T : drive.poses) tilted.push_back(tilt * T);
+  const std::vector<GravityObservation> observations =
+      gravity_observations(drive.stamps_ns, tilted, drive.imu, drive.keyframes(), {});
+  ASSERT_FALSE(observations.empty());
+  for (const GravityObservation& o : observations)
+    EXPECT_NEAR(tilt_deg(o, tilted[o.node * 10]), 2.0, 0.02);
+}
+
+TEST(GravityReference, TheBiasEntersThroughTheRotations) {
+  ImuModel model = ImuModel::exact();
+  model.accel_bias_mps2 = 0.3;
+  const Drive biased(model);
+  const std::vector<GravityObservation> observations =
+      gravity_observations(biased.stamps_ns, biased.poses, biased.imu, biased.keyframes(), {});
+  ASSERT_FALSE(observations.empty());
+  // The bias the simulator drew, recovered at rest from the first sample's error.
+  const Drive exact(ImuModel::exact());
+  const Eigen::Vector3d bias = biased.imu[0].accel_mps2 - exact.imu[0].accel_mps2;
+  EXPECT_NEAR(bias.norm(), 0.3, 1e-9);
+  for (const GravityObservation& o : observations)
+    EXPECT_LT(tilt_deg(o, biased.poses[o.node * 10], bias), 0.02);
+}
+
+TEST(GravityReference, NoSamplesOrTooFewGiveNoObservation) {
+  const Drive drive(ImuModel::exact());
+  EXPECT_TRUE(
+      gravity_observations(drive.stamps_ns, drive.poses, {}, drive.keyframes(), {}).empty());
+  const std::vector<ImuSample> few(drive.imu.begin(), drive.imu.begin() + 5);
+  EXPECT_TRUE(
+      gravity_observations(drive.stamps_ns, drive.poses, few, drive.keyframes(), {}).empty());
+  GravitySettings off;
+  off.enabled = false;
+  EXPECT_TRUE(gravity_observations(drive.stamps_ns, drive.poses, drive.imu, drive.keyframes(), off)
+                  .empty());
+}
+
+TEST(GravityReference, SamplesOutOfOrderAreDropped) {
+  std::vector<ImuSample> log;
+  ImuSample a, b, c;
+  a.stamp_ns = 10;
+  b.stamp_ns = 20;
+  c.stamp_ns = 15;
+  append_in_time_order(&log, {a, b});
+  append_in_time_order(&log, {c, b});
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_EQ(log.back().stamp_ns, 20);
+}
+
+}  // namespace
+}  // namespace featsense::slam::loops

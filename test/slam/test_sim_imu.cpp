@@ -1,0 +1,78 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <vector>
+
+#include "common/test_poses.hpp"
+#include "featsense/slam/sim/imu_simulator.hpp"
+#include "featsense/slam/sim/trajectory.hpp"
+
+namespace featsense::slam {
+namespace {
+
+/// A sensor standing still for 10 s, tilted.
+std::unique_ptr<PoseCurve> standing(const Eigen::Isometry3d& T) {
+  return make_sampled_trajectory({{0.0, T}, {10.0, T}});
+}
+
+TEST(ImuSimulator, AtRestReadsGravityUpInTheSensorFrame) {
+  const Eigen::Isometry3d T = test::pose(0.3, 0.2, -0.1, {1, 2, 3});
+  const std::vector<ImuSample> samples =
+      simulate_imu(*standing(T), ImuModel::exact(), 1, 0.0, 1.0, 1000);
+  ASSERT_EQ(samples.size(), 100u);  // 100 Hz over [0, 1)
+  EXPECT_EQ(samples.front().stamp_ns, 1000);
+  EXPECT_EQ(samples[1].stamp_ns, 1000 + 10'000'000);
+  const Eigen::Vector3d up = T.rotation().transpose() * Eigen::Vector3d::UnitZ();
+  for (const ImuSample& s : samples) {
+    EXPECT_LT((s.accel_mps2 - kStandardGravity * up).norm(), 1e-9);
+    EXPECT_LT(s.gyro_radps.norm(), 1e-9);
+  }
+}
+
+TEST(ImuSimulator, OnACircleReadsTheCentripetalAccelerationAndTheTurnRate) {
+  // A circle of radius 20 m at 5 m/s: 1.25 m/s^2 towards the centre, 0.25 rad/s of yaw.
+  std::vector<Eigen::Vector3d> waypoints;
+  for (int i = 0; i <= 72; ++i) {
+    const double a = i * M_PI / 36.0;
+    waypoints.emplace_back(20.0 * std::cos(a), 20.0 * std::sin(a), 0.0);
+  }
+  const std::unique_ptr<PoseCurve> path = make_spline_trajectory(waypoints, 5.0);
+  const double mid = path->duration_s() / 2.0;
+  const std::vector<ImuSample> samples =
+      simulate_imu(*path, ImuModel::exact(), 1, mid, mid + 1.0, 0);
+  ASSERT_FALSE(samples.empty());
+  for (const ImuSample& s : samples) {
+    const Eigen::Isometry3d T = path->pose(static_cast<double>(s.stamp_ns) * 1e-9);
+    const Eigen::Vector3d inward =
+        -Eigen::Vector3d(T.translation().x(), T.translation().y(), 0).normalized();
+    const Eigen::Vector3d expected =
+        T.rotation().transpose() * (1.25 * inward + kStandardGravity * Eigen::Vector3d::UnitZ());
+    EXPECT_LT((s.accel_mps2 - expected).norm(), 0.02);  // the spline is not quite a circle
+    EXPECT_NEAR(s.gyro_radps.z(), 0.25, 0.005);
+  }
+}
+
+TEST(ImuSimulator, NoiseAndBiasAreThoseOfTheModelAndRepeatable) {
+  const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const ImuModel model;  // the defaults: 0.02 m/s^2 noise, a 0.05 m/s^2 bias
+  const std::vector<ImuSample> a = simulate_imu(*standing(T), model, 7, 0.0, 10.0, 0);
+  const std::vector<ImuSample> b = simulate_imu(*standing(T), model, 7, 0.0, 10.0, 0);
+  const std::vector<ImuSample> other = simulate_imu(*standing(T), model, 8, 0.0, 10.0, 0);
+  ASSERT_EQ(a.size(), 1000u);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const ImuSample& s : a) mean += s.accel_mps2;
+  mean /= static_cast<double>(a.size());
+  double variance = 0.0;
+  for (const ImuSample& s : a) variance += (s.accel_mps2 - mean).squaredNorm();
+  variance /= 3.0 * static_cast<double>(a.size());
+  EXPECT_NEAR(std::sqrt(variance), model.accel_noise_mps2, 0.002);
+  const Eigen::Vector3d bias = mean - Eigen::Vector3d(0, 0, kStandardGravity);
+  EXPECT_NEAR(bias.norm(), model.accel_bias_mps2, 0.003);  // the mean of 1000 draws
+  EXPECT_EQ(a[123].accel_mps2, b[123].accel_mps2);
+  EXPECT_NE(a[123].accel_mps2, other[123].accel_mps2);
+}
+
+}  // namespace
+}  // namespace featsense::slam
