@@ -28,9 +28,11 @@
 #include "map_pass.hpp"
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
+#include "report_html.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
 #include "timing_stats.hpp"
+#include "trajectory_error_plot.hpp"
 
 namespace featsense::app {
 namespace {
@@ -319,6 +321,10 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       const slam::TrajectoryEvaluation final_evaluation =
           slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
       report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
+      report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
+          out,
+          trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front()),
+          report.contains("loops") ? report["loops"] : nlohmann::json::object());
       if (odometry && spans_a_plane(final_poses, kMinAlignmentSpreadM))
         T_truth_estimate = final_evaluation.alignment.T;
       // The front end's own poses too, to show what the loops and the refinement changed.
@@ -340,7 +346,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       report["eval"]["mesh"] = *evaluation;
     }
   }
+  report["html"] = kReportHtml;
   write_json(report, (out / "report.json").string());
+  write_report_html(out, report);
 
   if (result.frames_mapped == 0) {
     throw std::runtime_error("no scan was mapped" + (result.warnings.empty()
