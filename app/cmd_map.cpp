@@ -321,12 +321,13 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       const slam::TrajectoryEvaluation final_evaluation =
           slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
       report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
+      const bool spans_plane = spans_a_plane(final_poses, kMinAlignmentSpreadM);
+      TrajectoryErrorSeries series =
+          trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front());
+      series.rotation_fixed = spans_plane;
       report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
-          out,
-          trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front()),
-          report.contains("loops") ? report["loops"] : nlohmann::json::object());
-      if (odometry && spans_a_plane(final_poses, kMinAlignmentSpreadM))
-        T_truth_estimate = final_evaluation.alignment.T;
+          out, series, report.contains("loops") ? report["loops"] : nlohmann::json::object());
+      if (odometry && spans_plane) T_truth_estimate = final_evaluation.alignment.T;
       // The front end's own poses too, to show what the loops and the refinement changed.
       if (loops && !loops->loops.empty())
         report["eval"]["traj_before_loops"] = evaluate(first.poses);

@@ -29,7 +29,12 @@ nlohmann::json write_trajectory_error_png(const std::filesystem::path& out,
   plot.time_label = series.timed ? "time since the first scan (s)" : "pose";
   plot.times_s = series.time_s;
   plot.panels.push_back({"translation error (m)", series.translation_m, {215, 25, 28}});
-  plot.panels.push_back({"rotation error (deg)", series.rotation_deg, {35, 100, 220}});
+  plot.panels.push_back({series.rotation_fixed
+                             ? "rotation error (deg)"
+                             : "rotation error (deg); the path is nearly straight: the alignment "
+                               "leaves the turn about it free",
+                         series.rotation_deg,
+                         {35, 100, 220}});
   if (series.timed && loops_report.is_object() && loops_report.contains("loops")) {
     for (const nlohmann::json& loop : loops_report["loops"])
       if (loop.contains("time_s")) plot.marker_times_s.push_back(loop["time_s"].get<double>());

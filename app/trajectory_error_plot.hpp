@@ -19,6 +19,9 @@ struct TrajectoryErrorSeries {
   std::vector<double> translation_m;  ///< the APE of the pair (evaluation.ape_m)
   std::vector<double> rotation_deg;   ///< the angle between the aligned and the true rotation
   bool timed = true;                  ///< false: the truth has no stamps (KITTI without times)
+  /// False where the path is (nearly) straight: a fit of positions leaves the turn about the
+  /// line to chance, and the rotation error shows that turn as much as the estimate's error.
+  bool rotation_fixed = true;
 };
 
 /// The series of `evaluation` (slam::evaluate_trajectory of an estimate against `truth`).

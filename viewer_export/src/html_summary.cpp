@@ -35,7 +35,7 @@ void add_trajectory(Rows& rows, const nlohmann::json& report) {
   rows.emplace_back("ATE (RMSE, aligned)",
                     length_text_mm(number_at(*traj, {"ape", "rmse"})) + " over " +
                         json_text(number_at(*traj, {"ape", "count"})) + " poses, " +
-                        length_text_mm(number_at(*traj, {"ground_truth_length_m"})) + " of path");
+                        number_text(number_at(*traj, {"ground_truth_length_m"})) + " m of path");
   if (const nlohmann::json* before = json_at(report, {"eval", "traj_before_loops"}))
     rows.emplace_back("ATE before the loops", length_text_mm(number_at(*before, {"ape", "rmse"})));
   if (const nlohmann::json* unrefined = json_at(report, {"eval", "traj_unrefined"}))
