@@ -82,8 +82,9 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
     }
   }
   std::printf("  files in %s:\n", out.string().c_str());
-  for (const char* name : {"map.h5", "mesh.ply", "mesh.glb", "topdown.png", "mesh_error.ply",
-                           "mesh_error.glb", "mesh_error.png", "trajectory.tum", "report.json"}) {
+  for (const char* name :
+       {"map.h5", "mesh.ply", "mesh.glb", "topdown.png", "mesh_error.ply", "mesh_error.glb",
+        "mesh_error.png", "trajectory_error.png", "trajectory.tum", "report.json", "report.html"}) {
     if (fs::exists(out / name)) std::printf("    %s\n", (out / name).string().c_str());
   }
   std::printf("    %s (the scene, the true path and the surface points the sensor saw)\n",

@@ -28,9 +28,11 @@
 #include "map_pass.hpp"
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
+#include "report_html.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
 #include "timing_stats.hpp"
+#include "trajectory_error_plot.hpp"
 
 namespace featsense::app {
 namespace {
@@ -320,8 +322,13 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       const slam::TrajectoryEvaluation final_evaluation =
           slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
       report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
-      if (odometry && spans_a_plane(final_poses, kMinAlignmentSpreadM))
-        T_truth_estimate = final_evaluation.alignment.T;
+      const bool spans_plane = spans_a_plane(final_poses, kMinAlignmentSpreadM);
+      TrajectoryErrorSeries series =
+          trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front());
+      series.rotation_fixed = spans_plane;
+      report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
+          out, series, report.contains("loops") ? report["loops"] : nlohmann::json::object());
+      if (odometry && spans_plane) T_truth_estimate = final_evaluation.alignment.T;
       // The front end's own poses too, to show what the loops and the refinement changed.
       if (loops && loops->corrects_poses())
         report["eval"]["traj_before_loops"] = evaluate(first.poses);
@@ -341,7 +348,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
       report["eval"]["mesh"] = *evaluation;
     }
   }
+  report["html"] = kReportHtml;
   write_json(report, (out / "report.json").string());
+  write_report_html(out, report);
 
   if (result.frames_mapped == 0) {
     throw std::runtime_error("no scan was mapped" + (result.warnings.empty()

@@ -38,6 +38,8 @@ std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
 Command register_export(CLI::App& app, const CliContext& context);
 /// `featsense mesh MAP -o MESH`: marching cubes over a stored map.
 Command register_mesh(CLI::App& app, const CliContext& context);
+/// `featsense report OUT`: report.html from OUT/report.json and the pictures beside it.
+Command register_report(CLI::App& app, const CliContext& context);
 /// `featsense navmesh MESH -o NAV`: traversability layers for mesh-based navigation.
 Command register_navmesh(CLI::App& app, const CliContext& context);
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
@@ -14,6 +15,22 @@ namespace featsense::test {
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& path) {
+  // By its size: GCC 12 warns of a null dereference in istreambuf_iterator at -O2.
+  std::string text(static_cast<size_t>(fs::file_size(path)), '\0');
+  std::ifstream(path, std::ios::binary)
+      .read(text.data(), static_cast<std::streamsize>(text.size()));
+  return text;
+}
+
+size_t embedded_pictures(const std::string& html) {
+  const std::string data_uri = "src=\"data:image/png;base64,";
+  size_t count = 0;
+  for (size_t at = html.find(data_uri); at != std::string::npos; at = html.find(data_uri, at + 1))
+    ++count;
+  return count;
+}
 
 TEST(CliDemo, EstimatesThePosesAndScoresPathAndMesh) {
   const fs::path out = scratch_dir("cli_demo") / "estimated";
@@ -33,6 +50,27 @@ TEST(CliDemo, EstimatesThePosesAndScoresPathAndMesh) {
   EXPECT_TRUE(fs::is_regular_file(out / "topdown.png"));
   const nlohmann::json& plan = report["mesh"]["plan"];
   EXPECT_NEAR(plan["cut_high_m"].get<double>(), 2.0, 0.05) << plan.dump(2);
+
+  // The trajectory's error over time, named where eval names its files.
+  EXPECT_EQ(report["eval"]["traj"]["error_files"]["png"], "trajectory_error.png");
+  EXPECT_TRUE(fs::is_regular_file(out / "trajectory_error.png"));
+  EXPECT_NE(r.output.find("trajectory_error.png"), std::string::npos) << r.output;
+
+  // report.html (the same demo: it is the slow part): one page beside report.json with the
+  // pictures inside it, named in the report and the summary, written again by `report OUT`.
+  EXPECT_EQ(report["html"], "report.html");
+  EXPECT_NE(r.output.find("report.html"), std::string::npos) << r.output;
+  const std::string html = read_text(out / "report.html");
+  // The plan view, the mesh error and the trajectory error.
+  EXPECT_EQ(embedded_pictures(html), 3u);
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_LT(html.size(), 10u << 20);
+
+  fs::remove(out / "report.html");
+  const CommandResult again = run_featsense("report " + out.string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(embedded_pictures(read_text(out / "report.html")), 3u);
 }
 
 TEST(CliDemo, GtPosesMapsWithTheTruth) {
