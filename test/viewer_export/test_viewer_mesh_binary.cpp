@@ -32,17 +32,20 @@ TEST(ViewerMeshBinary, HeaderAndBlocksAsDocumented) {
   const std::string bytes =
       viewer_export::encode_viewer_mesh(m, {{"cost", {0.0f, 0.5f, 1.0f}}, {"e", {1, 2, 3}}});
   ASSERT_EQ(bytes.size(), viewer_export::viewer_mesh_bytes(3, 1, 2));
-  ASSERT_EQ(bytes.size(), 32u + 3 * 6 * 4 + 3 * 4 + 2 * 3 * 4);
+  // Normals: 9 bytes padded to 12.
+  ASSERT_EQ(bytes.size(), 32u + 3 * 3 * 4 + 12 + 3 * 4 + 2 * 3 * 4);
   EXPECT_EQ(std::string(bytes.data(), 8), std::string("FSVIEW1\0", 8));
   EXPECT_EQ(read_at<uint32_t>(bytes, 8), 3u);
   EXPECT_EQ(read_at<uint32_t>(bytes, 12), 1u);
   EXPECT_EQ(read_at<uint32_t>(bytes, 16), 2u);
   const size_t positions = 32;
   const size_t normals = positions + 36;
-  const size_t indices = normals + 36;
+  const size_t indices = normals + 12;
   const size_t layers = indices + 12;
   EXPECT_EQ(read_at<float>(bytes, positions + 4 * (3 * 2 + 2)), 2.0f);  // z of the third vertex
-  EXPECT_EQ(read_at<float>(bytes, normals + 8), 1.0f);
+  EXPECT_EQ(read_at<int8_t>(bytes, normals + 2), 127);                  // +Z
+  EXPECT_EQ(read_at<int8_t>(bytes, normals + 0), 0);
+  EXPECT_EQ(read_at<int8_t>(bytes, normals + 9), 0);  // padding
   EXPECT_EQ(read_at<uint32_t>(bytes, indices + 8), 2u);
   EXPECT_EQ(read_at<float>(bytes, layers + 4), 0.5f);
   EXPECT_EQ(read_at<float>(bytes, layers + 12 + 8), 3.0f);

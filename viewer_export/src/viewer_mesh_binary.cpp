@@ -1,7 +1,8 @@
 #include "featsense/viewer_export/viewer_mesh_binary.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
-#include <cstring>
 
 #include "featsense/viewer_export/mesh_file_error.hpp"
 
@@ -21,10 +22,13 @@ void append_u32(std::string& out, std::size_t value) {
   append(out, &v, sizeof(v));
 }
 
+/// The normals' block: 3 bytes per vertex, padded so that the indices after it are aligned.
+std::size_t normal_bytes(std::size_t vertices) { return (3 * vertices + 3) / 4 * 4; }
+
 }  // namespace
 
 std::size_t viewer_mesh_bytes(std::size_t vertices, std::size_t triangles, std::size_t layers) {
-  return kViewerMeshHeaderBytes + vertices * (6 + layers) * sizeof(float) +
+  return kViewerMeshHeaderBytes + vertices * (3 + layers) * sizeof(float) + normal_bytes(vertices) +
          triangles * 3 * sizeof(uint32_t);
 }
 
@@ -48,7 +52,14 @@ std::string encode_viewer_mesh(const mesh::TriangleMesh& mesh,
   append_u32(out, layers.size());
   out.append(kViewerMeshHeaderBytes - out.size(), '\0');
   append(out, mesh.vertices.data(), n * sizeof(Eigen::Vector3f));
-  append(out, mesh.normals.data(), n * sizeof(Eigen::Vector3f));
+  const std::size_t normals_start = out.size();
+  for (const Eigen::Vector3f& normal : mesh.normals) {
+    for (int k = 0; k < 3; ++k) {
+      const float scaled = std::clamp(normal[k], -1.0f, 1.0f) * 127.0f;
+      out.push_back(static_cast<char>(static_cast<int8_t>(std::lround(scaled))));
+    }
+  }
+  out.append(normals_start + normal_bytes(n) - out.size(), '\0');
   // Indices are never negative in a valid mesh: the int32 bits are the uint32 values.
   append(out, mesh.triangles.data(), mesh.triangles.size() * sizeof(Eigen::Vector3i));
   for (const VertexScalar& layer : layers) append(out, layer.values.data(), n * sizeof(float));

@@ -41,20 +41,21 @@
     const n = header.getUint32(8, true);
     const m = header.getUint32(12, true);
     const k = header.getUint32(16, true);
-    const expected = HEADER_BYTES + n * (6 + k) * 4 + m * 12;
+    const normalBytes = Math.ceil((3 * n) / 4) * 4;
+    const expected = HEADER_BYTES + n * (3 + k) * 4 + normalBytes + m * 12;
     if (buffer.byteLength !== expected)
       throw new Error('mesh.bin holds ' + buffer.byteLength + ' bytes, expected ' + expected);
     let offset = HEADER_BYTES;
-    const take = function (Type, count) {
+    const take = function (Type, count, bytes) {
       const array = new Type(buffer, offset, count);
-      offset += count * 4;
+      offset += bytes || count * 4;
       return array;
     };
     const mesh = {
       vertexCount: n,
       triangleCount: m,
       positions: take(Float32Array, 3 * n),
-      normals: take(Float32Array, 3 * n),
+      normals: take(Int8Array, 3 * n, normalBytes),  // times 127
       indices: take(Uint32Array, 3 * m),
       layers: {},
     };
@@ -102,7 +103,7 @@
       return {
         colour: function (v) {
           const n = mesh.normals;
-          return [(n[3 * v] + 1) * 127.5, (n[3 * v + 1] + 1) * 127.5, (n[3 * v + 2] + 1) * 127.5];
+          return [n[3 * v] + 127.5, n[3 * v + 1] + 127.5, n[3 * v + 2] + 127.5];
         },
         legend: null,
         hint: 'Red: +X, green: +Y, blue: +Z (up).',
@@ -188,7 +189,7 @@
   function buildMesh(mesh) {
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
-    geometry.setAttribute('normal', new THREE.BufferAttribute(mesh.normals, 3));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(mesh.normals, 3, true));
     geometry.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(3 * mesh.vertexCount), 3, true));
     geometry.setIndex(new THREE.BufferAttribute(mesh.indices, 1));
     geometry.computeBoundingBox();

@@ -10,7 +10,8 @@
 ///   bytes 16..19  uint32 layer count k
 ///   bytes 20..31  zero
 ///   float32[3n]   positions, map frame, metres (Z up)
-///   float32[3n]   unit normals
+///   int8[3n]      unit normals times 127 (what WebGL reads as normalized bytes: a quarter of
+///                 the bytes of floats, and shading cannot tell), zero-padded to 4 bytes
 ///   uint32[3m]    triangle corners, counter-clockwise seen from outside
 ///   float32[n]    each layer in turn (NaN where a vertex has no value)
 /// The layers' names and order are given beside the binary (the page's scene description).
