@@ -85,9 +85,13 @@ ViewServer::ViewServer(ViewContent content, const fs::path& three_folder)
     });
   }
   server.Get("/scene.json", [&state](const httplib::Request&, httplib::Response& response) {
+    response.set_header("Cache-Control", "no-store");
     response.set_content(state.content.scene.dump(), kJson);
   });
   server.Get("/mesh.bin", [&state](const httplib::Request&, httplib::Response& response) {
+    // Not kept in the browser's cache: writing megabytes there slows the page's load, and the
+    // next start of the server may serve another mesh.
+    response.set_header("Cache-Control", "no-store");
     response.set_content(state.content.mesh_binary, "application/octet-stream");
   });
   server.Get("/plan.png", [&state](const httplib::Request&, httplib::Response& response) {
