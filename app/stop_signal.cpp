@@ -4,21 +4,25 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstring>
 
 namespace featsense::app {
 namespace {
 
 std::atomic<int> g_signals{0};
+// Set before the handlers are installed, read in the handler.
+const char* g_message = "";
+std::size_t g_message_length = 0;
 struct sigaction g_old_int {};
 struct sigaction g_old_term {};
 
 extern "C" void on_stop_signal(int) {
   // Only async-signal-safe calls here: an atomic counter, write(2) and _exit(2).
   if (g_signals.fetch_add(1) == 0) {
-    static const char kFirst[] =
-        "\nfeatsense: stopping: finishing the scans in flight and writing the map "
-        "(press Ctrl+C again to quit at once)\n";
-    [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kFirst, sizeof(kFirst) - 1);
+    static const char kFirst[] = "\nfeatsense: stopping: ";
+    [[maybe_unused]] ssize_t n = ::write(STDERR_FILENO, kFirst, sizeof(kFirst) - 1);
+    n = ::write(STDERR_FILENO, g_message, g_message_length);
+    n = ::write(STDERR_FILENO, "\n", 1);
     return;
   }
   static const char kSecond[] = "\nfeatsense: quit; the map holds what was flushed before\n";
@@ -28,8 +32,10 @@ extern "C" void on_stop_signal(int) {
 
 }  // namespace
 
-StopSignal::StopSignal() {
+StopSignal::StopSignal(const char* message) {
   g_signals.store(0);
+  g_message = message;
+  g_message_length = std::strlen(message);
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);

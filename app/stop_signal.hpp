@@ -16,8 +16,13 @@ class Interrupted : public std::runtime_error {
 
 class StopSignal {
  public:
-  /// Installs the handlers for SIGINT and SIGTERM; the destructor restores the old ones.
-  StopSignal();
+  /// What a long run says on the first signal.
+  static constexpr const char* kMapMessage =
+      "finishing the scans in flight and writing the map (press Ctrl+C again to quit at once)";
+
+  /// Installs the handlers for SIGINT and SIGTERM; the destructor restores the old ones. The
+  /// first signal prints "featsense: stopping: `message`" (a static string).
+  explicit StopSignal(const char* message = kMapMessage);
   ~StopSignal();
   StopSignal(const StopSignal&) = delete;
   StopSignal& operator=(const StopSignal&) = delete;

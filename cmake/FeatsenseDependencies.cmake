@@ -21,6 +21,10 @@ pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
 # ROS 2 bags (sqlite3 storage) and MCAP's zstd chunks (slam/io).
 find_package(SQLite3 REQUIRED)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+# `featsense view`'s HTTP server (app/view_server.cpp) and its tests' client: Debian builds
+# cpp-httplib as a library whose header must see the same feature macros, which its pkg-config
+# file gives.
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 # The simulator: Embree casts the rays (slam/sim); assimp reads mesh files (viewer_export), the
 # simulator's scene files among them.
 find_package(embree 3 CONFIG REQUIRED)

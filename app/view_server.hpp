@@ -1,0 +1,46 @@
+#pragma once
+// `featsense view`'s HTTP server: the page (built into the program), three.js (from Debian's
+// libjs-three) and one output folder's content, at fixed routes only, so that no request can
+// name a file of its own choosing.
+//
+//   /, /index.html, /viewer.js, /viewer.css   the page
+//   /three/three.min.js, /three/OrbitControls.js, /three/FlyControls.js
+//   /scene.json   counts, bounds, layers, paths (view_content.hpp)
+//   /mesh.bin     the mesh (viewer_export/viewer_mesh_binary.hpp)
+//   /plan.png     topdown.png, 404 where there is none
+
+#include <atomic>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "view_content.hpp"
+
+namespace featsense::app {
+
+/// Where Debian's libjs-three puts three.js.
+inline constexpr const char* kThreeJsFolder = "/usr/share/javascript/three";
+
+class ViewServer {
+ public:
+  /// Reads three.js and its controls from `three_folder`; throws ViewError naming the file
+  /// that is missing (and the package that brings it).
+  ViewServer(ViewContent content, const std::filesystem::path& three_folder);
+  ~ViewServer();
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+
+  /// Binds to `host`:`port` (0: any free port) and returns the port; throws ViewError when
+  /// the port is in use or the address cannot be bound.
+  int bind(const std::string& host, int port);
+  /// Serves until stop(); returns false when the server could not run.
+  bool run();
+  /// Ends run() from any thread (also before run() has started listening).
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace featsense::app
