@@ -352,6 +352,8 @@ class BenchLoops {
       out["gravity_map_tilt_deg"] = {gravity_.map_tilt_deg.x(), gravity_.map_tilt_deg.y()};
       out["gravity_accel_bias_mps2"] = {gravity_.accel_bias_mps2.x(), gravity_.accel_bias_mps2.y(),
                                         gravity_.accel_bias_mps2.z()};
+      out["gravity_map_tilt_sigma_deg"] = gravity_.tilt_sigma_deg;
+      out["gravity_levelled_deg"] = gravity_.levelled_deg;
       out["gravity_rms_whitened"] = gravity_.rms_whitened;
     }
     if (!truth) return out;

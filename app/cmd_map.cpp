@@ -224,7 +224,18 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   const std::optional<LoopOutcome>& loops = first.loops;
   std::string second_pass = "no loop closed, no gravity";
   std::optional<PipelineResult> second;
-  if (loops && loops->corrects_poses()) {
+  // Levelled by gravity alone, the poses may move less than the map can show: then the first
+  // map stays (a second pass would double the run for nothing).
+  const double quarter_voxel_m = 0.25 * config.map.voxel_size_m;
+  const bool levelled_only = loops && loops->loops.empty() && loops->gravity.observations > 0;
+  if (levelled_only && loops->corrections_max_m < quarter_voxel_m) {
+    char why[160];
+    std::snprintf(why, sizeof why,
+                  "levelled by gravity, no scan moved more than a quarter voxel (%.1f mm): the "
+                  "map stays",
+                  1000.0 * loops->corrections_max_m);
+    second_pass = why;
+  } else if (loops && loops->corrects_poses()) {
     if (first.interrupted) {
       second_pass = "interrupted: the map keeps the odometry's poses";
     } else if (options.poses_only) {

@@ -87,6 +87,8 @@ nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms) {
     gravity_json["map_tilt_deg"] = {gravity.map_tilt_deg.x(), gravity.map_tilt_deg.y()};
     gravity_json["accel_bias_mps2"] = {gravity.accel_bias_mps2.x(), gravity.accel_bias_mps2.y(),
                                        gravity.accel_bias_mps2.z()};
+    gravity_json["map_tilt_sigma_deg"] = gravity.tilt_sigma_deg;
+    gravity_json["levelled_deg"] = gravity.levelled_deg;
     gravity_json["rms_whitened"] = gravity.rms_whitened;
   }
   return {{"keyframes", counts.keyframes},

@@ -235,12 +235,37 @@ TEST(PoseGraph, GravityTellsTheMapFramesTilt) {
   PoseGraph graph = square.graph(true);
   const PoseGraphSummary summary = graph.optimize();
   EXPECT_NEAR(summary.gravity.map_tilt_deg.norm(), 1.5, 0.02);
+  EXPECT_GT(summary.gravity.levelled_deg, 1.45);  // the square's turns tell the bias apart
   EXPECT_LT(square.worst_tilt_deg(graph.poses()), 0.02);
   EXPECT_LT((graph.pose(0).translation() - square.truth[0].translation()).norm(), 1e-9);
   const Eigen::Vector3d heading = graph.pose(0).rotation() * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d heading_true = square.truth[0].rotation() * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(std::atan2(heading.y(), heading.x()), std::atan2(heading_true.y(), heading_true.x()),
               1e-3);
+}
+
+TEST(PoseGraph, GravityDoesNotLevelByABiasItCannotTellFromATilt) {
+  // A straight path: the accelerometer's bias (0.1 m/s^2 forward) looks like a tilt of 0.58 deg
+  // that nothing tells apart. The first node is level; the graph must not tilt the map by it.
+  PoseGraph graph;
+  const size_t n = 40;
+  for (size_t i = 0; i < n; ++i) graph.add_node(pose(0.0, 0.0, 0.0, {double(i), 0.0, 1.0}));
+  for (size_t i = 1; i < n; ++i)
+    graph.add_edge({i - 1, i, pose(0.0, 0.0, 0.0, {1, 0, 0}), information(0.001, 0.01), false});
+  for (size_t i = 0; i < n; ++i) {
+    GravityObservation o;
+    o.node = i;
+    o.mean_force = Eigen::Vector3d(0.1, 0.0, 9.81);
+    o.sigma_rad = 0.005 * kDegree;
+    graph.add_gravity(o, 0.2);
+  }
+  const PoseGraphSummary summary = graph.optimize();
+  EXPECT_GT(summary.gravity.tilt_sigma_deg, 0.5);  // about 0.2 / 9.81 rad
+  EXPECT_LT(summary.gravity.levelled_deg, 0.05);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d up = graph.pose(i).rotation() * Eigen::Vector3d::UnitZ();
+    EXPECT_LT(std::acos(std::min(1.0, up.z())) / kDegree, 0.05) << i;
+  }
 }
 
 TEST(PoseGraph, RejectsBadGravity) {

@@ -3,9 +3,12 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -114,6 +117,35 @@ class BiasPriorCost {
  private:
   double sigma_;
 };
+
+constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+
+/// The covariance of the map frame's tilt from the gravity observations alone, with the bias
+/// (its prior included) marginalised, at the solution: how well gravity tells the vertical,
+/// not what the first node's attitude says.
+Eigen::Matrix2d tilt_covariance(const std::vector<GravityObservation>& observations,
+                                const BiasBasis& basis,
+                                const std::vector<Eigen::Quaterniond>& rotations,
+                                const Eigen::Vector2d& map_tilt, const Eigen::Vector2d& bias,
+                                double bias_prior) {
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+  information.bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() / (bias_prior * bias_prior);
+  for (const GravityObservation& o : observations) {
+    ceres::AutoDiffCostFunction<GravityCost, 2, 4, 2, 2> cost(new GravityCost(o, basis));
+    const double* parameters[3] = {rotations[o.node].coeffs().data(), map_tilt.data(), bias.data()};
+    double residual[2];
+    Eigen::Matrix<double, 2, 4, Eigen::RowMajor> d_rotation;
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> d_tilt, d_bias;
+    double* jacobians[3] = {d_rotation.data(), d_tilt.data(), d_bias.data()};
+    if (!cost.Evaluate(parameters, residual, jacobians)) continue;
+    Eigen::Matrix<double, 2, 4> J;
+    J << d_tilt, d_bias;
+    information += J.transpose() * J;
+  }
+  const Eigen::Matrix4d covariance = information.inverse();
+  const Eigen::Matrix2d tilt = covariance.topLeftCorner<2, 2>();
+  return tilt.allFinite() ? tilt : Eigen::Matrix2d::Identity();
+}
 
 /// U with U^T U = information.
 Matrix6d square_root(const Matrix6d& information) {
@@ -257,7 +289,20 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
   // observations of every node say (the first node alone, held fixed, would decide it else).
   Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
   if (!gravity_.empty()) {
-    const Eigen::Vector3d axis(map_tilt_rad_.x(), map_tilt_rad_.y(), 0.0);
+    // An accelerometer's bias is told from a tilt only once the path turns: until then the
+    // tilt found is as uncertain as the bias over g. Shrink it towards the first node's level
+    // by its significance (none at one sigma, 89 % at three).
+    const Eigen::Matrix2d covariance = tilt_covariance(gravity_, basis, rotations, map_tilt_rad_,
+                                                       bias_coordinates, bias_prior_mps2_);
+    summary.gravity.tilt_sigma_deg =
+        std::sqrt(std::max(
+            0.0,
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance).eigenvalues().maxCoeff())) *
+        kDegreesPerRadian;
+    const double significance2 = map_tilt_rad_.dot(covariance.inverse() * map_tilt_rad_);
+    const double shrink = significance2 > 1.0 ? 1.0 - 1.0 / significance2 : 0.0;
+    summary.gravity.levelled_deg = shrink * map_tilt_rad_.norm() * kDegreesPerRadian;
+    const Eigen::Vector3d axis(shrink * map_tilt_rad_.x(), shrink * map_tilt_rad_.y(), 0.0);
     if (axis.norm() > 0.0) {
       // About the first node: it keeps its position.
       level.linear() = Eigen::AngleAxisd(axis.norm(), axis.normalized()).toRotationMatrix();
@@ -274,7 +319,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
     // The residuals with the tilt they were solved with, before the frame is levelled.
     GravityEstimate& gravity = summary.gravity;
     gravity.observations = gravity_.size();
-    gravity.map_tilt_deg = map_tilt_rad_ * (180.0 / 3.14159265358979323846);
+    gravity.map_tilt_deg = map_tilt_rad_ * kDegreesPerRadian;
     accel_bias_ = basis * bias_coordinates;
     gravity.accel_bias_mps2 = accel_bias_;
     double sum = 0.0;

@@ -7,8 +7,9 @@
 /// Where an IMU saw gravity (gravity_reference.hpp), each observation pulls its node's up
 /// direction to the vertical; two more variables take what the map frame (the first node,
 /// held fixed) is tilted from the vertical, and the accelerometer's bias. The solved poses are
-/// then turned into the vertical frame (Z up, the first node's position and heading kept):
-/// the map is level with gravity, whatever the first scan's tilt.
+/// then turned towards the vertical frame (Z up, the first node's position and heading kept)
+/// by as much of that tilt as gravity is sure of: the map is level with gravity, whatever the
+/// first scan's tilt, once the path has turned enough to tell the bias from a tilt.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -46,9 +47,14 @@ struct PoseGraphSettings {
 /// What the gravity observations told, after a solve.
 struct GravityEstimate {
   size_t observations = 0;
-  /// How far the front end's map frame (the first node's) was tilted from the vertical, about
-  /// its x and y axes, degrees: the rotation the poses were levelled by.
+  /// How far the front end's map frame (the first node's) is tilted from the vertical, about
+  /// its x and y axes, degrees, and that tilt's standard deviation from gravity alone (the
+  /// accelerometer's bias is told from a tilt only where the path turns).
   Eigen::Vector2d map_tilt_deg = Eigen::Vector2d::Zero();
+  double tilt_sigma_deg = 0.0;
+  /// The rotation the poses were levelled by: the tilt shrunk by its significance (none
+  /// within one sigma).
+  double levelled_deg = 0.0;
   /// The accelerometer's bias across the up direction (along it, it is not observable).
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
   /// The root mean square of the observations' whitened errors (about 1 when the model's
