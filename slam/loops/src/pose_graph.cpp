@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -120,14 +118,20 @@ class BiasPriorCost {
 
 constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
 
-/// The covariance of the map frame's tilt from the gravity observations alone, with the bias
-/// (its prior included) marginalised, at the solution: how well gravity tells the vertical,
-/// not what the first node's attitude says.
-Eigen::Matrix2d tilt_covariance(const std::vector<GravityObservation>& observations,
-                                const BiasBasis& basis,
-                                const std::vector<Eigen::Quaterniond>& rotations,
-                                const Eigen::Vector2d& map_tilt, const Eigen::Vector2d& bias,
-                                double bias_prior) {
+/// What the gravity observations say at the solution, in one pass over them: the covariance
+/// of the map frame's tilt from them alone, with the bias (its prior included) marginalised
+/// (how well gravity tells the vertical, not what the first node's attitude says), and the
+/// sum of their squared whitened residuals.
+struct GravityFit {
+  Eigen::Matrix2d tilt_covariance = Eigen::Matrix2d::Identity();
+  double squared_residuals = 0.0;
+};
+
+GravityFit fit_gravity(const std::vector<GravityObservation>& observations, const BiasBasis& basis,
+                       const std::vector<Eigen::Quaterniond>& rotations,
+                       const Eigen::Vector2d& map_tilt, const Eigen::Vector2d& bias,
+                       double bias_prior) {
+  GravityFit fit;
   Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
   information.bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() / (bias_prior * bias_prior);
   for (const GravityObservation& o : observations) {
@@ -138,13 +142,14 @@ Eigen::Matrix2d tilt_covariance(const std::vector<GravityObservation>& observati
     Eigen::Matrix<double, 2, 2, Eigen::RowMajor> d_tilt, d_bias;
     double* jacobians[3] = {d_rotation.data(), d_tilt.data(), d_bias.data()};
     if (!cost.Evaluate(parameters, residual, jacobians)) continue;
+    fit.squared_residuals += residual[0] * residual[0] + residual[1] * residual[1];
     Eigen::Matrix<double, 2, 4> J;
     J << d_tilt, d_bias;
     information += J.transpose() * J;
   }
-  const Eigen::Matrix4d covariance = information.inverse();
-  const Eigen::Matrix2d tilt = covariance.topLeftCorner<2, 2>();
-  return tilt.allFinite() ? tilt : Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d tilt = information.inverse().topLeftCorner<2, 2>();
+  if (tilt.allFinite()) fit.tilt_covariance = tilt;
+  return fit;
 }
 
 /// U with U^T U = information.
@@ -289,49 +294,39 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
   // observations of every node say (the first node alone, held fixed, would decide it else).
   Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
   if (!gravity_.empty()) {
+    accel_bias_ = basis * bias_coordinates;
+    const GravityFit fit =
+        fit_gravity(gravity_, basis, rotations, map_tilt_rad_, bias_coordinates, bias_prior_mps2_);
+    GravityEstimate& gravity = summary.gravity;
+    gravity.observations = gravity_.size();
+    gravity.map_tilt_deg = map_tilt_rad_ * kDegreesPerRadian;
+    gravity.accel_bias_mps2 = accel_bias_;
+    gravity.rms_whitened =
+        std::sqrt(fit.squared_residuals / (2.0 * static_cast<double>(gravity_.size())));
+    gravity.tilt_sigma_deg =
+        std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(fit.tilt_covariance)
+                                    .eigenvalues()
+                                    .maxCoeff())) *
+        kDegreesPerRadian;
     // An accelerometer's bias is told from a tilt only once the path turns: until then the
     // tilt found is as uncertain as the bias over g. Shrink it towards the first node's level
     // by its significance (none at one sigma, 89 % at three).
-    const Eigen::Matrix2d covariance = tilt_covariance(gravity_, basis, rotations, map_tilt_rad_,
-                                                       bias_coordinates, bias_prior_mps2_);
-    summary.gravity.tilt_sigma_deg =
-        std::sqrt(std::max(
-            0.0,
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance).eigenvalues().maxCoeff())) *
-        kDegreesPerRadian;
-    const double significance2 = map_tilt_rad_.dot(covariance.inverse() * map_tilt_rad_);
+    const double significance2 = map_tilt_rad_.dot(fit.tilt_covariance.inverse() * map_tilt_rad_);
     const double shrink = significance2 > 1.0 ? 1.0 - 1.0 / significance2 : 0.0;
-    summary.gravity.levelled_deg = shrink * map_tilt_rad_.norm() * kDegreesPerRadian;
+    gravity.levelled_deg = shrink * map_tilt_rad_.norm() * kDegreesPerRadian;
     const Eigen::Vector3d axis(shrink * map_tilt_rad_.x(), shrink * map_tilt_rad_.y(), 0.0);
     if (axis.norm() > 0.0) {
       // About the first node: it keeps its position.
       level.linear() = Eigen::AngleAxisd(axis.norm(), axis.normalized()).toRotationMatrix();
       level.translation() = translations[0] - level.linear() * translations[0];
     }
+    map_tilt_rad_.setZero();  // the poses are levelled: the next solve starts from level
   }
   for (size_t i = 0; i < poses_.size(); ++i) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = rotations[i].normalized().toRotationMatrix();
     pose.translation() = translations[i];
     poses_[i] = level * pose;
-  }
-  if (!gravity_.empty()) {
-    // The residuals with the tilt they were solved with, before the frame is levelled.
-    GravityEstimate& gravity = summary.gravity;
-    gravity.observations = gravity_.size();
-    gravity.map_tilt_deg = map_tilt_rad_ * kDegreesPerRadian;
-    accel_bias_ = basis * bias_coordinates;
-    gravity.accel_bias_mps2 = accel_bias_;
-    double sum = 0.0;
-    for (const GravityObservation& observation : gravity_) {
-      double residual[2];
-      const double* q = rotations[observation.node].coeffs().data();
-      const GravityCost cost(observation, basis);
-      cost(q, map_tilt_rad_.data(), bias_coordinates.data(), residual);
-      sum += residual[0] * residual[0] + residual[1] * residual[1];
-    }
-    gravity.rms_whitened = std::sqrt(sum / (2.0 * static_cast<double>(gravity_.size())));
-    map_tilt_rad_.setZero();  // the poses are levelled: the next solve starts from level
   }
   for (const PoseGraphEdge& edge : edges_) {
     if (!edge.loop) continue;
