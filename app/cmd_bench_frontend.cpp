@@ -278,8 +278,7 @@ class BenchLoops {
 
   /// The corrected poses of every scan added.
   slam::Trajectory finish() {
-    const size_t levelled = closer_.add_gravity(path_.stamps_ns, path_.poses, imu_);
-    if (!closer_.loops().empty() || levelled > 0) gravity_ = closer_.optimise().gravity;
+    gravity_ = closer_.finish(path_.stamps_ns, path_.poses, imu_).gravity;
     return corrected();
   }
 

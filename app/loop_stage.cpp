@@ -71,8 +71,7 @@ LoopOutcome LoopStage::finish() {
   if (failure_) std::rethrow_exception(failure_);
   LoopOutcome out;
   // The loop thread is done with the closer: the gravity goes in from here.
-  const size_t levelled = closer_.add_gravity(path_.stamps_ns, path_.poses, imu_);
-  if (!closer_.loops().empty() || levelled > 0) out.final_optimisation = closer_.optimise();
+  out.final_optimisation = closer_.finish(path_.stamps_ns, path_.poses, imu_);
   out.gravity = out.final_optimisation.gravity;
   out.loops = closer_.loops();
   out.counts = closer_.counts();

@@ -371,9 +371,9 @@ void LoopCloser::add_loop_edge(size_t candidate, size_t query,
 
 PoseGraphSummary LoopCloser::optimise() { return optimise_timed(); }
 
-size_t LoopCloser::add_gravity(const std::vector<int64_t>& path_stamps_ns,
-                               const std::vector<Eigen::Isometry3d>& path,
-                               const std::vector<ImuSample>& samples) {
+PoseGraphSummary LoopCloser::finish(const std::vector<int64_t>& path_stamps_ns,
+                                    const std::vector<Eigen::Isometry3d>& path,
+                                    const std::vector<ImuSample>& samples) {
   std::vector<int64_t> keyframe_stamps_ns;
   keyframe_stamps_ns.reserve(keyframes_.size());
   for (const Keyframe& keyframe : keyframes_) keyframe_stamps_ns.push_back(keyframe.stamp_ns);
@@ -381,7 +381,8 @@ size_t LoopCloser::add_gravity(const std::vector<int64_t>& path_stamps_ns,
       gravity_observations(path_stamps_ns, path, samples, keyframe_stamps_ns, settings_.gravity);
   for (const GravityObservation& observation : observations)
     graph_.add_gravity(observation, settings_.gravity.bias_prior_mps2);
-  return observations.size();
+  if (loops_.empty() && observations.empty()) return {};
+  return optimise_timed();
 }
 
 TrajectoryCorrection LoopCloser::correction() const {

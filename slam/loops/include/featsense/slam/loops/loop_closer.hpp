@@ -151,13 +151,14 @@ class LoopCloser {
   void add_loop_edge(size_t candidate, size_t query, const Eigen::Isometry3d& T_candidate_query,
                      const Matrix6d& information);
 
-  /// The gravity the IMU's `samples` (time order) saw around each keyframe, with the rotations
-  /// and velocities of the front end's `path` (every scan's stamp and pose, stamps increasing),
-  /// for the next optimisations. Returns how many keyframes got an observation (none without
-  /// samples or with loop.gravity off).
-  size_t add_gravity(const std::vector<int64_t>& path_stamps_ns,
-                     const std::vector<Eigen::Isometry3d>& path,
-                     const std::vector<ImuSample>& samples);
+  /// The end of a run: the gravity the IMU's `samples` (time order) saw around each keyframe,
+  /// with the rotations and velocities of the front end's `path` (every scan's stamp and pose,
+  /// stamps increasing), goes into the graph (none without samples or with loop.gravity off),
+  /// and the graph is optimised once more where it holds loops or gravity. Its summary, empty
+  /// where nothing was optimised.
+  PoseGraphSummary finish(const std::vector<int64_t>& path_stamps_ns,
+                          const std::vector<Eigen::Isometry3d>& path,
+                          const std::vector<ImuSample>& samples);
 
   /// Optimises the graph with every loop and gravity observation (at the end of a run).
   PoseGraphSummary optimise();
