@@ -18,7 +18,7 @@
 #include "featsense/slam/odometry/feature_odometry.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/refine/refinement_cloud.hpp"
-#include "featsense/slam/trajectory/pose_interpolation.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
@@ -172,18 +172,14 @@ class BenchRefinement {
   /// The placements made final by this scan (with their scans' sequence numbers).
   std::vector<slam::ScanPlacement> add(const slam::Scan& scan,
                                        const slam::odometry::OdometryResult& odometry) {
-    if (odometry.elapsed_s > 0.0) {
-      motion_ = odometry.T_previous_sensor;
-      period_s_ = odometry.elapsed_s;
-    }
+    if (odometry.sweep.moving()) sweep_ = odometry.sweep;
     slam::ScanPlacement placed;
     placed.sequence = scan.sequence;
     placed.stamp_ns = scan.stamp_ns;
     placed.T_map_sensor = odometry.T_map_sensor;
-    if (deskew_ && period_s_ > 0.0) {
+    if (deskew_ && sweep_.moving()) {
       placed.column_T_map_sensor = slam::column_poses(scan, placed.T_map_sensor, [&](double t) {
-        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor *
-                                                slam::motion_fraction(motion_, t / period_s_));
+        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor * sweep_.at(t));
       });
     }
     return take(refiner_.add(scan, std::move(placed)));
@@ -246,8 +242,7 @@ class BenchRefinement {
   slam::refine::RefineSettings settings_;
   slam::refine::PlacementRefiner refiner_;
   bool deskew_;
-  Eigen::Isometry3d motion_ = Eigen::Isometry3d::Identity();
-  double period_s_ = 0.0;
+  slam::SweepMotion sweep_;  ///< the last scan's whose stamp advanced
   slam::Trajectory refined_;
 };
 
@@ -447,7 +442,7 @@ nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const Cli
     const auto start = Clock::now();
     const slam::FeatureSet found = slam::features::extract_features(*scan, settings);
     const auto extracted = Clock::now();
-    const slam::odometry::OdometryResult result = odometry.register_scan(found);
+    const slam::odometry::OdometryResult result = odometry.register_scan(found, scan->imu);
     const double registration = ms_since(extracted);
     const double features = std::chrono::duration<double, std::milli>(extracted - start).count();
     estimate.stamps_ns.push_back(scan->stamp_ns);

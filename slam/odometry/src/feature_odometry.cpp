@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "featsense/slam/odometry/local_feature_map.hpp"
@@ -36,7 +37,8 @@ std::unique_ptr<LocalFeatureMap> FeatureOdometry::new_map() const {
                                            settings_.map_radius_m);
 }
 
-OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
+OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
+                                              const std::vector<ImuSample>& imu) {
   OdometryResult result;
   const TimedFeatures raw =
       voxel_filtered(features, settings_.edge_voxel_m, settings_.surface_voxel_m);
@@ -44,10 +46,12 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
   result.scan_surfaces = raw.surfaces.size();
 
   // The constant-velocity prediction, scaled to the time since the last scan.
-  RegistrationStart start{last_pose_, last_pose_, 0.0};
+  RegistrationStart start{last_pose_, last_pose_, 0.0, GyroTwist()};
   if (started_) {
     result.elapsed_s = static_cast<double>(features.stamp_ns - last_stamp_ns_) * 1e-9;
     start.elapsed_s = std::max(result.elapsed_s, 0.0);
+    start.twist = GyroTwist::from_samples(last_imu_, imu, last_stamp_ns_, features.stamp_ns,
+                                          features.stamp_ns);
     if (result.elapsed_s > 0.0 && last_motion_s_ > 0.0) {
       start.prediction =
           last_pose_ * motion_fraction(last_motion_, result.elapsed_s / last_motion_s_);
@@ -64,18 +68,21 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features) {
   } else {
     pose = register_to_map(*map_, raw, start, settings_, result);
     if (first_scan_ && result.diagnostics.converged && start.elapsed_s > 0.0) {
-      pose = restart_map(raw, start, pose, result);
+      pose = restart_map(raw, start, pose, imu, result);
     }
   }
   first_scan_.reset();
   if (!started_ && !raw.empty()) first_scan_ = std::make_unique<TimedFeatures>(raw);
-  add_to_map(raw, pose, features.stamp_ns, result);
+  if (!started_ || result.elapsed_s > 0.0) last_imu_ = imu;
+  add_to_map(raw, SweepMotion(last_pose_.inverse() * pose, result.elapsed_s, start.twist), pose,
+             features.stamp_ns, result);
   return result;
 }
 
 Eigen::Isometry3d FeatureOdometry::restart_map(const TimedFeatures& raw,
                                                const RegistrationStart& start,
                                                const Eigen::Isometry3d& pose,
+                                               const std::vector<ImuSample>& imu,
                                                OdometryResult& result) {
   // The first scan went into the map as measured: its motion was unknown. A sensor already
   // moving then (a car at 5 m/s moves 0.5 m within the sweep) leaves a distorted map that
@@ -83,13 +90,20 @@ Eigen::Isometry3d FeatureOdometry::restart_map(const TimedFeatures& raw,
   // the first scan deskewed with it, and this scan is registered again.
   Eigen::Isometry3d best = pose;
   if (!settings_.deskew) return best;
+  // The first sweep's turn: the gyroscope's rate against its mean from the first stamp to
+  // this one, the period of the motion it is deskewed with (last_imu_ is still the first's).
+  const int64_t first_stamp_ns = last_stamp_ns_;
+  const int64_t stamp_ns =
+      first_stamp_ns + static_cast<int64_t>(std::llround(start.elapsed_s * 1e9));
+  const GyroTwist first_twist =
+      GyroTwist::from_samples(last_imu_, imu, first_stamp_ns, stamp_ns, first_stamp_ns);
   for (int round = 0; round < kMaxRestartRounds; ++round) {
     map_ = new_map();
-    const TimedFeatures first =
-        deskewed(*first_scan_, start.previous.inverse() * best, start.elapsed_s);
+    const TimedFeatures first = deskewed(
+        *first_scan_, SweepMotion(start.previous.inverse() * best, start.elapsed_s, first_twist));
     map_->add(first.edges, first.surfaces, start.previous);
     OdometryResult again = result;
-    const RegistrationStart from_best{best, start.previous, start.elapsed_s};
+    const RegistrationStart from_best{best, start.previous, start.elapsed_s, start.twist};
     const Eigen::Isometry3d refined = register_to_map(*map_, raw, from_best, settings_, again);
     if (!again.diagnostics.converged) break;  // the restarted map holds the first scan anyway
     result = again;
@@ -100,16 +114,17 @@ Eigen::Isometry3d FeatureOdometry::restart_map(const TimedFeatures& raw,
   return best;
 }
 
-void FeatureOdometry::add_to_map(const TimedFeatures& raw, const Eigen::Isometry3d& pose,
-                                 int64_t stamp_ns, OdometryResult& result) {
+void FeatureOdometry::add_to_map(const TimedFeatures& raw, const SweepMotion& sweep,
+                                 const Eigen::Isometry3d& pose, int64_t stamp_ns,
+                                 OdometryResult& result) {
   const bool moved = started_ && result.elapsed_s > 0.0;
-  const Eigen::Isometry3d motion = last_pose_.inverse() * pose;
+  const Eigen::Isometry3d& motion = sweep.motion();
   result.T_map_sensor = pose;
   result.T_previous_sensor = motion;
+  if (moved) result.sweep = sweep;
   const auto map_start = std::chrono::steady_clock::now();
   if (!raw.empty()) {
-    const TimedFeatures points =
-        settings_.deskew && moved ? deskewed(raw, motion, result.elapsed_s) : raw;
+    const TimedFeatures points = settings_.deskew && moved ? deskewed(raw, sweep) : raw;
     map_->add(points.edges, points.surfaces, pose);
   }
   result.timing.map_update_ms = ms_since(map_start);

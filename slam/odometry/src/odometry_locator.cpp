@@ -9,7 +9,7 @@
 
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
-#include "featsense/slam/trajectory/pose_interpolation.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
@@ -43,7 +43,7 @@ class FeatureOdometryLocator final : public OdometryLocator {
     // best is the sensor's at about their mean time, and the pose at the stamp follows from
     // the motion between the scans. (Deskewing the features with the last scan's motion
     // before registration fed each motion error into the next estimate and made it oscillate.)
-    const OdometryResult result = odometry_.register_scan(found);
+    const OdometryResult result = odometry_.register_scan(found, scan.imu);
     counts_.features_ms.push_back(milliseconds(extracted - start));
     counts_.registration_ms.push_back(milliseconds(std::chrono::steady_clock::now() - extracted));
     ++counts_.scans;
@@ -57,11 +57,8 @@ class FeatureOdometryLocator final : public OdometryLocator {
             "): the pose is the prediction";
     }
     if (!jump.empty()) why = why.empty() ? jump : why + "; " + jump;
-    if (result.elapsed_s > 0.0) {
-      last_motion_ = result.T_previous_sensor;
-      last_period_s_ = result.elapsed_s;
-    }
-    const bool moving = last_period_s_ > 0.0;
+    if (result.sweep.moving()) last_sweep_ = result.sweep;
+    const bool moving = last_sweep_.moving();
 
     ScanPlacement placed;
     placed.sequence = scan.sequence;
@@ -69,14 +66,12 @@ class FeatureOdometryLocator final : public OdometryLocator {
     placed.T_map_sensor = T_map_first_ * result.T_map_sensor;
     if (moving && !deskew_) {
       const double fit_time_s = mean_time(found.edge_time_s, found.surface_time_s);
-      placed.T_map_sensor =
-          placed.T_map_sensor * motion_fraction(last_motion_, -fit_time_s / last_period_s_);
+      placed.T_map_sensor = placed.T_map_sensor * last_sweep_.at(-fit_time_s);
     }
     placed.diagnostics = result.diagnostics;
     if (deskew_ && moving) {
       placed.column_T_map_sensor = column_poses(scan, placed.T_map_sensor, [&](double t) {
-        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor *
-                                                motion_fraction(last_motion_, t / last_period_s_));
+        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor * last_sweep_.at(t));
       });
     }
     return placed;
@@ -117,8 +112,9 @@ class FeatureOdometryLocator final : public OdometryLocator {
   FeatureOdometry odometry_;
   bool deskew_;
   Eigen::Isometry3d T_map_first_;
-  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
-  double last_period_s_ = 0.0;
+  /// The motion within the last scan whose stamp advanced (a scan stamped like the last one
+  /// is deskewed with it).
+  SweepMotion last_sweep_;
   double period_s_ = 0.0;  ///< the shortest time between two scans so far
   OdometryCounts counts_;
 };

@@ -312,8 +312,9 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
   int iterations = 0;
   for (int step = 0; step < settings.optimization_steps; ++step) {
     const auto association_start = Clock::now();
-    const TimedFeatures points =
-        deskew ? deskewed(raw, start.previous.inverse() * pose, start.elapsed_s) : raw;
+    const TimedFeatures points = deskew ? deskewed(raw, SweepMotion(start.previous.inverse() * pose,
+                                                                    start.elapsed_s, start.twist))
+                                        : raw;
     c = associate(map, points, deskew ? start.elapsed_s : 0.0, pose,
                   settings.max_correspondence_distance_m, cache);
     result.timing.association_ms += ms_since(association_start);

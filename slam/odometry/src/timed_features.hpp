@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "featsense/slam/feature_set.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
 
 namespace featsense::slam::odometry {
 
@@ -25,8 +26,7 @@ TimedFeatures voxel_filtered(const FeatureSet& features, double edge_voxel_m,
                              double surface_voxel_m);
 
 /// The points in the sensor frame at the stamp: a point measured t after the stamp moved by
-/// the fraction t / period_s of `motion` (previous stamp's sensor <- this stamp's sensor),
-/// the sensor moving at constant velocity. period_s <= 0 leaves the points as measured.
-TimedFeatures deskewed(const TimedFeatures& raw, const Eigen::Isometry3d& motion, double period_s);
+/// sweep.at(t). A sweep that is not moving leaves the points as measured.
+TimedFeatures deskewed(const TimedFeatures& raw, const SweepMotion& sweep);
 
 }  // namespace featsense::slam::odometry

@@ -1,5 +1,8 @@
 #include "featsense/slam/trajectory/scan_motions.hpp"
 
+#include <algorithm>
+#include <iterator>
+#include <map>
 #include <string>
 #include <utility>
 
@@ -8,18 +11,65 @@
 
 namespace featsense::slam {
 
-void ScanMotions::add(const Scan& scan, const ScanPlacement& placement) {
-  if (!placement.deskewed()) return;
-  const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
-  size_t last = times.size();
-  for (size_t col = 0; col < times.size(); ++col) {
-    if (times[col] && (last == times.size() || *times[col] > *times[last])) last = col;
-  }
-  if (last == times.size() || !(*times[last] > 0.f)) return;
+namespace {
+
+/// Knots over the sweep besides the stamp.
+constexpr int kKnots = 8;
+
+Eigen::Isometry3d pose_of(const Eigen::Quaternionf& rotation, const Eigen::Vector3f& translation) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation.cast<double>().normalized().toRotationMatrix();
+  pose.translation() = translation.cast<double>();
+  return pose;
+}
+
+}  // namespace
+
+ScanMotion ScanMotion::of(const Scan& scan, const ScanPlacement& placement) {
   ScanMotion kept;
-  kept.motion = placement.T_map_sensor.inverse() * placement.column_T_map_sensor[last];
-  kept.span_s = static_cast<double>(*times[last]);
-  motions_[placement.stamp_ns] = kept;
+  if (!placement.deskewed()) return kept;
+  const std::vector<std::optional<float>> times = scan.column_time_offsets_s();
+  std::map<float, size_t> columns;  // by time: the knots come out in time order
+  float first = 0.f, last = 0.f;
+  for (size_t col = 0; col < times.size() && col < placement.column_T_map_sensor.size(); ++col) {
+    if (!times[col]) continue;
+    columns.emplace(*times[col], col);
+    first = std::min(first, *times[col]);
+    last = std::max(last, *times[col]);
+  }
+  if (!(last > first)) return kept;
+  // The stamp (identity) and the columns nearest to kKnots instants spread over the sweep.
+  std::map<float, Eigen::Isometry3d> knots{{0.f, Eigen::Isometry3d::Identity()}};
+  const Eigen::Isometry3d from_map = placement.T_map_sensor.inverse();
+  for (int k = 0; k < kKnots; ++k) {
+    const float want = first + (last - first) * static_cast<float>(k) / (kKnots - 1);
+    auto near = columns.lower_bound(want);
+    if (near == columns.end() ||
+        (near != columns.begin() && want - std::prev(near)->first < near->first - want)) {
+      near = std::prev(near);
+    }
+    knots.emplace(near->first, from_map * placement.column_T_map_sensor[near->second]);
+  }
+  for (const auto& [time_s, pose] : knots) {
+    kept.times_s_.push_back(time_s);
+    kept.rotations_.push_back(Eigen::Quaterniond(pose.linear()).normalized().cast<float>());
+    kept.translations_.push_back(pose.translation().cast<float>());
+  }
+  return kept;
+}
+
+Eigen::Isometry3d ScanMotion::at(double t_s) const {
+  if (times_s_.size() < 2) return Eigen::Isometry3d::Identity();
+  size_t k = 1;
+  while (k + 1 < times_s_.size() && times_s_[k] < t_s) ++k;
+  const double t0 = times_s_[k - 1], t1 = times_s_[k];
+  return interpolate_pose(pose_of(rotations_[k - 1], translations_[k - 1]),
+                          pose_of(rotations_[k], translations_[k]), (t_s - t0) / (t1 - t0));
+}
+
+void ScanMotions::add(const Scan& scan, const ScanPlacement& placement) {
+  ScanMotion kept = ScanMotion::of(scan, placement);
+  if (!kept.empty()) motions_[placement.stamp_ns] = std::move(kept);
 }
 
 std::optional<ScanMotion> ScanMotions::at(int64_t stamp_ns) const {
@@ -45,8 +95,7 @@ class ReplayLocator final : public ScanLocator {
     if (!placed) return placed;
     const Eigen::Isometry3d at_stamp = placed->T_map_sensor;
     placed->column_T_map_sensor = column_poses(scan, at_stamp, [&](double t) {
-      return std::optional<Eigen::Isometry3d>(at_stamp *
-                                              motion_fraction(kept->motion, t / kept->span_s));
+      return std::optional<Eigen::Isometry3d>(at_stamp * kept->at(t));
     });
     return placed;
   }

@@ -6,10 +6,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "featsense/slam/feature_set.hpp"
+#include "featsense/slam/imu_sample.hpp"
 #include "featsense/slam/odometry/odometry_result.hpp"
 #include "featsense/slam/odometry/odometry_settings.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
 
 namespace featsense::slam::odometry {
 
@@ -31,14 +34,17 @@ class FeatureOdometry {
   /// In degenerate directions the pose keeps the prediction. Every scan with features is
   /// then added to the map at the pose given. The second scan restarts the map with the
   /// first one deskewed, once the motion is known, and is registered again.
-  OdometryResult register_scan(const FeatureSet& features);
+  /// `imu`: the IMU's samples of this sweep (Scan::imu), where the source has them: with
+  /// the last sweep's they bend the deskewing motion by the measured turn (SweepMotion).
+  OdometryResult register_scan(const FeatureSet& features, const std::vector<ImuSample>& imu = {});
 
  private:
   std::unique_ptr<LocalFeatureMap> new_map() const;
   Eigen::Isometry3d restart_map(const TimedFeatures& raw, const RegistrationStart& start,
-                                const Eigen::Isometry3d& pose, OdometryResult& result);
-  void add_to_map(const TimedFeatures& raw, const Eigen::Isometry3d& pose, int64_t stamp_ns,
-                  OdometryResult& result);
+                                const Eigen::Isometry3d& pose, const std::vector<ImuSample>& imu,
+                                OdometryResult& result);
+  void add_to_map(const TimedFeatures& raw, const SweepMotion& sweep, const Eigen::Isometry3d& pose,
+                  int64_t stamp_ns, OdometryResult& result);
 
   OdometrySettings settings_;
   std::unique_ptr<LocalFeatureMap> map_;
@@ -50,6 +56,8 @@ class FeatureOdometry {
   /// The last motion (previous <- current) and the time it took, for the prediction.
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
   double last_motion_s_ = 0.0;
+  /// The last sweep's IMU samples: the gyroscope's mean rate over the period before a stamp.
+  std::vector<ImuSample> last_imu_;
 };
 
 }  // namespace featsense::slam::odometry

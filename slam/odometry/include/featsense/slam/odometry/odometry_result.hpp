@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "featsense/slam/scan_locator.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
 
 namespace featsense::slam::odometry {
 
@@ -17,9 +18,13 @@ struct OdometryResult {
   /// cannot be trusted it is the constant-velocity prediction.
   Eigen::Isometry3d T_map_sensor = Eigen::Isometry3d::Identity();
   /// The motion since the previous scan (previous sensor <- this sensor); identity for the
-  /// first scan. The motion within the scan (deskewing) is not estimated here yet.
+  /// first scan.
   Eigen::Isometry3d T_previous_sensor = Eigen::Isometry3d::Identity();
   double elapsed_s = 0.0;  ///< time since the previous scan (0 for the first)
+  /// The motion within the scan, as its features went into the map: T_previous_sensor over
+  /// elapsed_s, bent by the gyroscope where the scan had IMU samples; not moving for the
+  /// first scan and a scan whose stamp did not advance.
+  SweepMotion sweep;
 
   /// converged, iterations (Ceres iterations in all), degenerate, fitness_m (mean
   /// point-to-line / point-to-plane distance of the correspondences at the result).
