@@ -106,6 +106,10 @@ TEST(OusterImuPacket, WrongSizeIsRefused) {
   EXPECT_FALSE(
       detail::decode_ouster_imu_packet(packet.data(), packet.size(), Eigen::Matrix3d::Identity()));
   EXPECT_FALSE(detail::decode_ouster_imu_packet(nullptr, 48, Eigen::Matrix3d::Identity()));
+  const std::vector<uint8_t> nan =
+      imu_packet(1000, Eigen::Vector3f(0.0f, std::nanf(""), 1.0f), Eigen::Vector3f::Zero());
+  EXPECT_FALSE(
+      detail::decode_ouster_imu_packet(nan.data(), nan.size(), Eigen::Matrix3d::Identity()));
 }
 
 TEST(ImuSweepAssigner, EachSampleGoesToTheSweepThatHoldsIt) {

@@ -44,6 +44,7 @@ std::optional<ImuSample> decode_ouster_imu_packet(const uint8_t* data, size_t si
   sample.stamp_ns = static_cast<int64_t>(load_le<uint64_t>(data + kGyroTimestampOffset));
   sample.accel_mps2 = imu_to_sensor * (load_le_vector(data + kAccelOffset) * kStandardGravity);
   sample.gyro_radps = imu_to_sensor * (load_le_vector(data + kGyroOffset) * kDegToRad);
+  if (!sample.accel_mps2.allFinite() || !sample.gyro_radps.allFinite()) return std::nullopt;
   return sample;
 }
 

@@ -24,7 +24,8 @@ Eigen::Matrix3d ouster_imu_to_sensor_rotation(const OusterMetadata& metadata);
 /// gyroscope's timestamp: the clock of the lidar columns' timestamps. Only the rotation of
 /// imu_to_sensor is applied: the lever arm (about 2 cm) would add the centripetal term
 /// w x (w x r), below 0.01 m/s^2 even at 1 rad/s, and a term in the angular acceleration
-/// that the samples cannot tell. Nullopt where the packet is not 48 bytes.
+/// that the samples cannot tell. Nullopt where the packet is not 48 bytes or holds a
+/// non-finite value.
 std::optional<ImuSample> decode_ouster_imu_packet(const uint8_t* data, size_t size,
                                                   const Eigen::Matrix3d& imu_to_sensor);
 

@@ -178,7 +178,8 @@ class OusterPcapSource final : public ScanSource {
     if (malformed_imu_packets_ > 0) {
       warn(path_ + ": " + std::to_string(malformed_imu_packets_) + " packets on the IMU port " +
            std::to_string(imu_port_) + " were not " +
-           std::to_string(detail::kOusterImuPacketBytes) + "-byte IMU packets; skipped");
+           std::to_string(detail::kOusterImuPacketBytes) +
+           "-byte IMU packets of finite values; skipped");
     }
     if (std::optional<Scan> scan = assembler_.flush()) pending_.push_back(std::move(*scan));
   }

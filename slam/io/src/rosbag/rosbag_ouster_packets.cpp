@@ -42,9 +42,12 @@ class OusterImuPacketDecoder final : public ImuMessageDecoder {
     std::optional<ImuSample> sample =
         detail::decode_ouster_imu_packet(payload.data, payload.size, imu_to_sensor_);
     if (!sample) {
-      report.warn("IMU packet at offset " + std::to_string(message.offset) + " has " +
-                  std::to_string(payload.size) + " bytes, not " +
-                  std::to_string(detail::kOusterImuPacketBytes) + "; ignored");
+      report.warn("IMU packet at offset " + std::to_string(message.offset) +
+                  (payload.size == detail::kOusterImuPacketBytes
+                       ? std::string(" holds a non-finite value")
+                       : " has " + std::to_string(payload.size) + " bytes, not " +
+                             std::to_string(detail::kOusterImuPacketBytes)) +
+                  "; ignored");
     }
     return sample;
   }
