@@ -79,6 +79,7 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
                  {"fields", info.fields},
                  {"topics", info.topics},
                  {"times", info.times},
+                 {"imu", info.imu},
                  {"valid_points", valid},
                  {"time_span_s", span_s},
                  {"first_stamp_ns", first_stamp.value_or(0)},
@@ -109,6 +110,7 @@ InfoResult summarize(slam::ScanSource& source, bool quiet) {
     t += (i == 0 ? "topics:    " : "           ") + info.topics[i] + "\n";
   }
   t += "times:     " + (info.times.empty() ? std::string("unknown") : info.times) + "\n";
+  t += "imu:       " + (info.imu.empty() ? std::string("none") : info.imu) + "\n";
   std::snprintf(line, sizeof line, "valid points per frame: min %.0f, median %.0f, max %.0f\n",
                 valid["min"].get<double>(), valid["median"].get<double>(),
                 valid["max"].get<double>());

@@ -216,6 +216,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                                : std::string(),
                pipeline.loops ? ", loops closed" : std::string());
   if (odometry && !no_loops.empty()) spdlog::info("loop closure off: {}", no_loops);
+  if (!info.imu.empty()) spdlog::info("IMU: {}", info.imu);
 
   MapPassOutput pass =
       run_map_pass(source, *locator, pipeline, config,

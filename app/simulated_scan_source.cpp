@@ -14,6 +14,7 @@ SimulatedScanSource::SimulatedScanSource(const PreparedSimulation& simulation,
   info_.frames = simulation.frames;
   info_.fields = {"x", "y", "z", "intensity", "reflectivity", "t"};
   info_.times = "per column, simulated";
+  info_.imu = "simulated, riding with the sensor";
 }
 
 std::optional<slam::Scan> SimulatedScanSource::next() {

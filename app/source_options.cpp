@@ -44,6 +44,9 @@ std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& confi
   options.times_from_azimuth = config.sensor.times_from_azimuth;
   options.velodyne_calibration = config.sensor.calibration;
   options.scan_cut_deg = config.sensor.scan_cut_deg;
+  options.imu = config.sensor.imu;
+  options.imu_topic = config.sensor.imu_topic;
+  options.imu_rotation_deg = config.sensor.imu_rotation_deg;
   return slam::open_scan_source(input, options);
 }
 

@@ -162,16 +162,17 @@ KeySpec backend_key() {
           [](const Config& c) { return YAML::Node(to_string(c.map.backend)); }};
 }
 
-/// A file path that may be unset (null).
+/// A file path (or another name: `expected` says what) that may be unset (null).
 template <typename Section>
 KeySpec optional_path_key(std::string path, SectionOf<Section> section,
-                          Member<Section, std::optional<std::string>> field) {
+                          Member<Section, std::optional<std::string>> field,
+                          std::string expected = "a file path") {
   return {std::move(path),
           [=](Config& c, const YAML::Node& v, const std::string& where) {
             if (v.IsNull()) {
               (c.*section).*field = std::nullopt;
             } else if (!v.IsScalar() || v.Scalar().empty()) {
-              fail(where, "expected a file path or null");
+              fail(where, "expected " + expected + " or null");
             } else {
               (c.*section).*field = v.Scalar();
             }
@@ -193,6 +194,11 @@ std::vector<KeySpec> make_specs() {
       bool_key("sensor.times_from_azimuth", &Config::sensor, &SensorConfig::times_from_azimuth),
       optional_path_key("sensor.calibration", &Config::sensor, &SensorConfig::calibration),
       number_key("sensor.scan_cut_deg", &Config::sensor, &SensorConfig::scan_cut_deg, {0.0, 360.0}),
+      bool_key("sensor.imu", &Config::sensor, &SensorConfig::imu),
+      optional_path_key("sensor.imu_topic", &Config::sensor, &SensorConfig::imu_topic,
+                        "a topic name"),
+      vec3_key("sensor.imu_rotation", &Config::sensor, &SensorConfig::imu_rotation_deg,
+               {-360.0, 360.0}),
       number_key("map.voxel_size", &Config::map, &MapConfig::voxel_size_m, {0.005, 2.0}),
       number_key("map.truncation", &Config::map, &MapConfig::truncation_m, {0.0, 10.0, true}),
       number_key("map.max_weight", &Config::map, &MapConfig::max_weight, {1.0, 500.0}),

@@ -91,6 +91,10 @@ TEST(Config, WrongTypesAreErrorsNamingTheKey) {
            {"map.backend=gpu", "map.backend"},
            {"sensor.preset=os1-129", "sensor.preset"},
            {"map.voxel_size=.nan", "map.voxel_size"},
+           {"sensor.imu=sometimes", "sensor.imu"},
+           {"sensor.imu_topic=[a,b]", "sensor.imu_topic"},
+           {"sensor.imu_rotation=[0,0]", "sensor.imu_rotation"},
+           {"sensor.imu_rotation=[0,.inf,0]", "finite"},
        }) {
     const std::string message = error_of([&] { load_config({}, {assignment}); });
     EXPECT_NE(message.find(key), std::string::npos) << assignment << " -> '" << message << "'";
@@ -105,7 +109,7 @@ TEST(Config, AbsurdValuesAreRejected) {
        {"map.voxel_size=0", "map.voxel_size=-1", "map.voxel_size=100", "map.truncation=0",
         "map.max_weight=0", "map.size=[40,40,-1]", "map.shift_threshold=0",
         "odometry.optimization_steps=0", "sensor.min_range=-1", "sensor.max_range=0",
-        "refine.distance=-2"}) {
+        "refine.distance=-2", "sensor.imu_rotation=[0,0,361]", "sensor.imu_rotation=[-400,0,0]"}) {
     EXPECT_FALSE(error_of([&] { load_config({}, {assignment}); }).empty()) << assignment;
   }
 }

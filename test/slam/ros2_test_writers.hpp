@@ -40,6 +40,7 @@ class CdrBytes {
     raw(s.data(), s.size());
     return u8(0);
   }
+  CdrBytes& f64(double v) { return aligned(&v, 8); }
   CdrBytes& bytes(const std::vector<uint8_t>& b) { return raw(b.data(), b.size()); }
   CdrBytes& byte_sequence(const std::vector<uint8_t>& b) {
     u32(static_cast<uint32_t>(b.size()));

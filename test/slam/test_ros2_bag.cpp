@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -227,6 +228,80 @@ TEST(Mcap, NotAnMcapAndGarbageAfterTheMagic) {
   for (int i = 0; i < 100; ++i) bytes.push_back(static_cast<uint8_t>(i * 37));
   test::write_bytes(dir / "garbage.mcap", bytes);
   EXPECT_THROW(open_scan_source((dir / "garbage.mcap").string()), InputError);
+}
+
+/// A sensor_msgs/msg/Imu in CDR at `stamp_ns`: a level IMU at rest turning about z.
+std::vector<uint8_t> cdr_imu(int64_t stamp_ns) {
+  test::CdrBytes out;
+  out.time(stamp_ns).string("imu_link");
+  for (double q : {0.0, 0.0, 0.0, 1.0}) out.f64(q);
+  for (int i = 0; i < 9; ++i) out.f64(0.0);
+  for (double w : {0.0, 0.0, 0.25}) out.f64(w);
+  for (int i = 0; i < 9; ++i) out.f64(0.0);
+  for (double a : {0.0, 0.0, 9.81}) out.f64(a);
+  for (int i = 0; i < 9; ++i) out.f64(0.0);
+  return out.data();
+}
+
+/// 100 Hz IMU messages from a sweep before the first cloud to one after the last.
+std::vector<TestMessage> imu_messages(const std::string& topic, int clouds) {
+  std::vector<TestMessage> messages;
+  const int64_t first = spec_of(0).stamp_ns;
+  for (int64_t t = first - kPeriodNs; t < first + (clouds + 1) * kPeriodNs; t += 10'000'000) {
+    messages.push_back({topic, t + 1'000'000, cdr_imu(t)});
+  }
+  return messages;
+}
+
+/// Each scan holds the 10 samples of its sweep, level and at rest.
+void expect_imu_per_sweep(ScanSource& source, size_t scans) {
+  size_t read = 0;
+  while (std::optional<Scan> scan = source.next()) {
+    ++read;
+    ASSERT_EQ(scan->imu.size(), 10u) << "scan " << scan->sequence;
+    for (const ImuSample& sample : scan->imu) {
+      EXPECT_GE(sample.stamp_ns, scan->stamp_ns);
+      EXPECT_LT(sample.stamp_ns, scan->stamp_ns + kPeriodNs);
+      EXPECT_EQ(sample.accel_mps2, Eigen::Vector3d(0.0, 0.0, 9.81));
+      EXPECT_EQ(sample.gyro_radps, Eigen::Vector3d(0.0, 0.0, 0.25));
+    }
+  }
+  EXPECT_EQ(read, scans);
+  EXPECT_EQ(source.stats().warning_count, 0u);
+}
+
+TEST(Ros2Bag, ImuMessagesGoWithTheirSweeps) {
+  const auto dir = test::scratch_dir("ros2_bag_imu");
+  std::vector<TestMessage> messages = cloud_messages(0, 3);
+  for (TestMessage& m : imu_messages("/imu/data", 3)) messages.push_back(std::move(m));
+  std::sort(messages.begin(), messages.end(),
+            [](const TestMessage& a, const TestMessage& b) { return a.time_ns < b.time_ns; });
+  test::write_sqlite_bag(dir / "bag.db3",
+                         {{kTopic, kCloudType}, {"/imu/data", "sensor_msgs/msg/Imu"}}, messages);
+  std::unique_ptr<ScanSource> source = open_scan_source((dir / "bag.db3").string());
+  EXPECT_NE(source->info().imu.find("/imu/data"), std::string::npos) << source->info().imu;
+  expect_imu_per_sweep(*source, 3);
+}
+
+TEST(Mcap, ImuMessagesGoWithTheirSweeps) {
+  const auto dir = test::scratch_dir("mcap_imu");
+  McapLayoutSpec spec;
+  spec.compression = McapCompression::kZstd;
+  McapTestWriter writer(spec);
+  const uint16_t clouds = writer.add_topic(kTopic, kCloudType);
+  const uint16_t imu = writer.add_topic("/imu", "sensor_msgs/msg/Imu");
+  std::vector<TestMessage> messages = cloud_messages(0, 4);
+  for (TestMessage& m : imu_messages("/imu", 4)) messages.push_back(std::move(m));
+  std::sort(messages.begin(), messages.end(),
+            [](const TestMessage& a, const TestMessage& b) { return a.time_ns < b.time_ns; });
+  for (const TestMessage& m : messages) {
+    writer.add_message(m.topic == kTopic ? clouds : imu, m.time_ns, m.data);
+  }
+  const auto path = dir / "imu.mcap";
+  test::write_bytes(path, writer.write());
+  std::unique_ptr<ScanSource> source = open_scan_source(path.string());
+  EXPECT_NE(source->info().imu.find("/imu"), std::string::npos) << source->info().imu;
+  expect_imu_per_sweep(*source, 4);
 }
 
 }  // namespace

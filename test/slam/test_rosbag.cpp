@@ -9,8 +9,13 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "rosbag/bag_imu_topic.hpp"
 #include "rosbag/bag_record_reader.hpp"
+#include "rosbag/imu_message.hpp"
 #include "rosbag/rosbag_source.hpp"
+#include "slam/ros2_test_writers.hpp"
 #include "slam/rosbag_test_clouds.hpp"
 #include "slam/rosbag_test_source.hpp"
 #include "slam/rosbag_test_writer.hpp"
@@ -482,6 +487,171 @@ TEST(Rosbag, ReadingSpeedOfLargeOrganizedClouds) {
   std::printf("[ speed    ] record reader alone: %.2f s, %.0f MB/s of messages\n", walk_seconds,
               static_cast<double>(walked_bytes) / 1e6 / walk_seconds);
   std::filesystem::remove_all(dir);
+}
+
+/// A sensor_msgs/Imu in ROS 1 serialization: header, orientation, angular velocity and
+/// linear acceleration, each followed by its 3x3 covariance.
+std::vector<uint8_t> ros1_imu(int64_t stamp_ns, const Eigen::Vector3d& gyro,
+                              const Eigen::Vector3d& accel) {
+  test::RosBytes out;
+  out.u32(7).time(stamp_ns).string("imu_link");
+  for (double q : {0.0, 0.0, 0.0, 1.0}) out.value(q);
+  for (int i = 0; i < 9; ++i) out.value(-1.0);
+  for (int i = 0; i < 3; ++i) out.value(gyro[i]);
+  for (int i = 0; i < 9; ++i) out.value(0.0);
+  for (int i = 0; i < 3; ++i) out.value(accel[i]);
+  for (int i = 0; i < 9; ++i) out.value(0.0);
+  return out.bytes();
+}
+
+/// The same in CDR (ROS 2: no seq; the doubles aligned to 8 bytes after the frame id).
+std::vector<uint8_t> cdr_imu(int64_t stamp_ns, const Eigen::Vector3d& gyro,
+                             const Eigen::Vector3d& accel) {
+  test::CdrBytes out;
+  out.time(stamp_ns).string("imu");  // 4 + 4 + 4 + 4 bytes: the doubles need padding
+  for (double q : {0.0, 0.0, 0.0, 1.0}) out.f64(q);
+  for (int i = 0; i < 9; ++i) out.f64(-1.0);
+  for (int i = 0; i < 3; ++i) out.f64(gyro[i]);
+  for (int i = 0; i < 9; ++i) out.f64(0.0);
+  for (int i = 0; i < 3; ++i) out.f64(accel[i]);
+  for (int i = 0; i < 9; ++i) out.f64(0.0);
+  return out.data();
+}
+
+TEST(ImuMessage, DecodesBothEncodings) {
+  const Eigen::Vector3d gyro(0.1, -0.2, 0.3);
+  const Eigen::Vector3d accel(0.5, 0.25, 9.8);
+  const std::vector<uint8_t> ros1 = ros1_imu(kFirstStamp, gyro, accel);
+  const ImuSample a = imu_message({ros1.data(), ros1.size()}, MessageEncoding::kRos1);
+  EXPECT_EQ(a.stamp_ns, kFirstStamp);
+  EXPECT_EQ(a.gyro_radps, gyro);
+  EXPECT_EQ(a.accel_mps2, accel);
+
+  const std::vector<uint8_t> cdr = cdr_imu(kFirstStamp, gyro, accel);
+  const ImuSample b = imu_message({cdr.data(), cdr.size()}, MessageEncoding::kCdr);
+  EXPECT_EQ(b.stamp_ns, kFirstStamp);
+  EXPECT_EQ(b.gyro_radps, gyro);
+  EXPECT_EQ(b.accel_mps2, accel);
+
+  // Cut short: an error naming the field, never a read past the end.
+  EXPECT_THROW(imu_message({ros1.data(), ros1.size() - 80}, MessageEncoding::kRos1),
+               SerializationError);
+  EXPECT_THROW(imu_message({cdr.data(), 30}, MessageEncoding::kCdr), SerializationError);
+}
+
+TEST(ImuMessage, RollPitchYawTurnsTheImuIntoTheSensorFrame) {
+  // Yaw 90 deg: the IMU's x is the sensor's y.
+  const Eigen::Matrix3d yaw = rotation_from_roll_pitch_yaw_deg({0.0, 0.0, 90.0});
+  EXPECT_TRUE((yaw * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
+  // Roll 180 deg: an IMU mounted upside down reads gravity's reaction along its -z.
+  const Eigen::Matrix3d roll = rotation_from_roll_pitch_yaw_deg({180.0, 0.0, 0.0});
+  EXPECT_TRUE((roll * Eigen::Vector3d(0, 0, -9.8)).isApprox(Eigen::Vector3d(0, 0, 9.8), 1e-12));
+  // Roll first, then pitch, then yaw (R = Rz Ry Rx).
+  const Eigen::Matrix3d all = rotation_from_roll_pitch_yaw_deg({10.0, 20.0, 30.0});
+  const double d = M_PI / 180.0;
+  const Eigen::Matrix3d expected = (Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(20 * d, Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(10 * d, Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
+  EXPECT_TRUE(all.isApprox(expected, 1e-12));
+}
+
+/// Clouds on /points every 100 ms and a 200 Hz sensor_msgs/Imu on `imu_topics` (each the
+/// same samples), starting 50 ms before the first cloud and ending 50 ms after the last
+/// sweep.
+std::string cloud_and_imu_bag(const std::filesystem::path& dir, const std::string& name,
+                              const std::vector<std::string>& imu_topics, int frames) {
+  TestBagWriter writer(TestCompression::kLz4);
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  std::vector<uint32_t> imus;
+  for (const std::string& topic : imu_topics) {
+    imus.push_back(writer.add_connection(topic, "sensor_msgs/Imu"));
+  }
+  int64_t imu_stamp = kFirstStamp - 50'000'000;
+  const int64_t imu_end = kFirstStamp + frames * kFramePeriodNs + 50'000'000;
+  for (int frame = 0; frame < frames; ++frame) {
+    const CloudSpec s = frame_spec(CloudSpec(), frame);
+    // The cloud is written once its sweep is over, as drivers publish it.
+    while (imu_stamp < s.stamp_ns + kFramePeriodNs && imu_stamp < imu_end) {
+      for (uint32_t imu : imus) {
+        writer.add_message(
+            imu, imu_stamp,
+            ros1_imu(imu_stamp, Eigen::Vector3d(0.0, 0.0, 0.5), Eigen::Vector3d(1.0, 0.0, 9.8)));
+      }
+      imu_stamp += 5'000'000;
+    }
+    writer.add_message(points, s.stamp_ns + kFramePeriodNs,
+                       test::make_reference_cloud(s).serialize());
+  }
+  while (imu_stamp < imu_end) {
+    for (uint32_t imu : imus) {
+      writer.add_message(
+          imu, imu_stamp,
+          ros1_imu(imu_stamp, Eigen::Vector3d(0.0, 0.0, 0.5), Eigen::Vector3d(1.0, 0.0, 9.8)));
+    }
+    imu_stamp += 5'000'000;
+  }
+  return test::write_bag_file(dir, name, writer.finish());
+}
+
+TEST(RosbagImu, TheOneImuTopicGoesWithTheClouds) {
+  const auto dir = test::scratch_dir("rosbag_imu_one");
+  const std::string path = cloud_and_imu_bag(dir, "imu.bag", {"/imu/data"}, 3);
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  EXPECT_TRUE(contains(source->info().imu, "/imu/data")) << source->info().imu;
+  EXPECT_TRUE(contains(source->info().imu, "aligned with the LiDAR")) << source->info().imu;
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 3u);
+  for (const Scan& scan : scans) {
+    ASSERT_EQ(scan.imu.size(), 20u) << "scan " << scan.sequence;  // 200 Hz over 100 ms
+    for (size_t i = 0; i < scan.imu.size(); ++i) {
+      EXPECT_GE(scan.imu[i].stamp_ns, scan.stamp_ns);
+      EXPECT_LT(scan.imu[i].stamp_ns, scan.stamp_ns + kFramePeriodNs);
+      if (i > 0) {
+        EXPECT_EQ(scan.imu[i].stamp_ns - scan.imu[i - 1].stamp_ns, 5'000'000);
+      }
+      EXPECT_EQ(scan.imu[i].accel_mps2, Eigen::Vector3d(1.0, 0.0, 9.8));
+    }
+  }
+  EXPECT_EQ(source->stats().warning_count, 0u);
+
+  // A configured rotation turns the samples: yaw 90 deg takes the IMU's x to the sensor's y.
+  SourceOptions turned;
+  turned.imu_rotation_deg = {0.0, 0.0, 90.0};
+  const std::unique_ptr<ScanSource> rotated = open_bag(path, turned);
+  EXPECT_TRUE(contains(rotated->info().imu, "sensor.imu_rotation")) << rotated->info().imu;
+  const std::vector<Scan> rotated_scans = test::read_scans(*rotated);
+  ASSERT_EQ(rotated_scans.size(), 3u);
+  ASSERT_FALSE(rotated_scans[0].imu.empty());
+  EXPECT_TRUE(rotated_scans[0].imu[0].accel_mps2.isApprox(Eigen::Vector3d(0.0, 1.0, 9.8), 1e-12));
+
+  SourceOptions off;
+  off.imu = false;
+  const std::unique_ptr<ScanSource> plain = open_bag(path, off);
+  EXPECT_TRUE(plain->info().imu.empty());
+  for (const Scan& scan : test::read_scans(*plain)) EXPECT_TRUE(scan.imu.empty());
+}
+
+TEST(RosbagImu, SeveralImuTopicsNeedAName) {
+  const auto dir = test::scratch_dir("rosbag_imu_several");
+  const std::string path = cloud_and_imu_bag(dir, "imus.bag", {"/imu/a", "/imu/b"}, 2);
+  const std::unique_ptr<ScanSource> source = open_bag(path);
+  EXPECT_TRUE(contains(source->info().imu, "several")) << source->info().imu;
+  for (const Scan& scan : test::read_scans(*source)) EXPECT_TRUE(scan.imu.empty());
+
+  SourceOptions named;
+  named.imu_topic = "/imu/b";
+  const std::unique_ptr<ScanSource> chosen = open_bag(path, named);
+  EXPECT_TRUE(contains(chosen->info().imu, "/imu/b")) << chosen->info().imu;
+  const std::vector<Scan> scans = test::read_scans(*chosen);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].imu.size(), 20u);
+
+  SourceOptions wrong;
+  wrong.imu_topic = "/imu/c";
+  EXPECT_TRUE(contains(error_of(path, wrong), "did you mean")) << error_of(path, wrong);
+  wrong.imu_topic = "/points";
+  EXPECT_TRUE(contains(error_of(path, wrong), "not sensor_msgs/Imu")) << error_of(path, wrong);
 }
 
 }  // namespace

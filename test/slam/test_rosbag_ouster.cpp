@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <string>
 #include <vector>
@@ -188,6 +189,77 @@ TEST(RosbagOuster, PacketsOfAnotherSizeAreCountedAndIgnored) {
   EXPECT_EQ(source->stats().warning_count, 3u);
   expect_scan_matches_packets(scans[0], nlohmann::json::parse(json),
                               contents.messages.at("/os_node0/lidar_packets"));
+}
+
+TEST(RosbagOuster, RealBagImuPacketsComeWithTheFrame) {
+  FEATSENSE_SHARED_FILE(path, "ouster/512x10_raw.bag");
+  const BagContents contents = read_contents(path);
+  ASSERT_EQ(contents.messages.at("/os_node0/imu_packets").size(), 10u);
+
+  const std::unique_ptr<ScanSource> source = open_rosbag(path.string(), {});
+  EXPECT_NE(source->info().imu.find("/os_node0/imu_packets"), std::string::npos)
+      << source->info().imu;
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  const Scan& scan = scans[0];
+  EXPECT_EQ(source->stats().warning_count, 0u);
+  ASSERT_FALSE(scan.imu.empty());
+  for (size_t i = 0; i < scan.imu.size(); ++i) {
+    const ImuSample& sample = scan.imu[i];
+    EXPECT_GE(sample.stamp_ns, scan.stamp_ns);
+    EXPECT_LT(sample.stamp_ns, scan.stamp_ns + 100'000'000);
+    EXPECT_GT(sample.accel_mps2.norm(), 9.0);
+    EXPECT_LT(sample.accel_mps2.norm(), 11.5);
+    EXPECT_LT(sample.gyro_radps.norm(), 0.5);
+    if (i > 0) {
+      EXPECT_GT(sample.stamp_ns, scan.imu[i - 1].stamp_ns);
+    }
+  }
+  std::cout << "IMU samples in the frame: " << scan.imu.size() << ", first |a| "
+            << scan.imu.front().accel_mps2.norm() << " m/s^2, stamps "
+            << scan.imu.front().stamp_ns - scan.stamp_ns << " .. "
+            << scan.imu.back().stamp_ns - scan.stamp_ns << " ns after the frame's stamp\n";
+
+  SourceOptions off;
+  off.imu = false;
+  const std::unique_ptr<ScanSource> without = open_rosbag(path.string(), off);
+  EXPECT_TRUE(without->info().imu.empty());
+  const std::vector<Scan> plain = test::read_scans(*without);
+  ASSERT_EQ(plain.size(), 1u);
+  EXPECT_TRUE(plain[0].imu.empty());
+}
+
+TEST(RosbagOuster, DamagedImuPacketsAreCountedAndSkipped) {
+  FEATSENSE_SHARED_FILE(path, "ouster/512x10_raw.bag");
+  const auto dir = test::scratch_dir("rosbag_ouster_imu_damaged");
+  const BagContents contents = read_contents(path);
+  TestBagWriter writer(TestCompression::kLz4);
+  const uint32_t metadata = writer.add_connection("/os_node0/metadata", "std_msgs/String");
+  const uint32_t lidar = writer.add_connection("/os_node0/lidar_packets", "ouster_ros/PacketMsg");
+  const uint32_t imu = writer.add_connection("/os_node0/imu_packets", "ouster_ros/PacketMsg");
+  writer.add_message(metadata, contents.times.at("/os_node0/metadata")[0],
+                     contents.messages.at("/os_node0/metadata")[0]);
+  for (size_t i = 0; i < contents.messages.at("/os_node0/lidar_packets").size(); ++i) {
+    writer.add_message(lidar, contents.times.at("/os_node0/lidar_packets")[i],
+                       contents.messages.at("/os_node0/lidar_packets")[i]);
+  }
+  const auto& imu_packets = contents.messages.at("/os_node0/imu_packets");
+  for (size_t i = 0; i < imu_packets.size(); ++i) {
+    const int64_t time = contents.times.at("/os_node0/imu_packets")[i];
+    writer.add_message(imu, time, imu_packets[i]);
+    if (i == 2) writer.add_message(imu, time, test::RosBytes().byte_array({1, 2, 3}).bytes());
+    if (i == 4) writer.add_message(imu, time, {1, 2});  // not even a whole u8[] length
+  }
+  const std::string bag = test::write_bag_file(dir, "damaged_imu.bag", writer.finish());
+
+  const std::unique_ptr<ScanSource> whole = open_rosbag(path.string(), {});
+  const std::vector<Scan> expected = test::read_scans(*whole);
+  const std::unique_ptr<ScanSource> source = open_rosbag(bag, {});
+  const std::vector<Scan> scans = test::read_scans(*source);
+  ASSERT_EQ(scans.size(), 1u);
+  ASSERT_EQ(expected.size(), 1u);
+  EXPECT_EQ(scans[0].imu.size(), expected[0].imu.size());
+  EXPECT_EQ(source->stats().warning_count, 2u);
 }
 
 TEST(RosbagOuster, UnorganizedCloudIsOrganizedByRing) {

@@ -43,7 +43,7 @@ void simulate_lab(const std::filesystem::path& dir, uint64_t seed) {
   writer.finish(mesh);
 }
 
-const char* const kFiles[] = {"frame_000000.pcd",  "frame_000001.pcd", "sequence.yaml",
+const char* const kFiles[] = {"frame_000000.pcd",  "frame_000001.pcd", "sequence.yaml", "imu.csv",
                               "gt_trajectory.tum", "gt_mesh.ply",      "gt_points.ply"};
 
 TEST(SimDeterminism, SameSeedSameBytesWhateverTheThreadCount) {

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "featsense/config/config_error.hpp"
+#include "featsense/slam/io/imu_csv.hpp"
 #include "featsense/slam/io/scan_writers.hpp"
 #include "featsense/slam/io/sequence_file.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
@@ -110,6 +111,14 @@ void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d&
     write_scan_pcd(frame.scan, (std::filesystem::path(folder_) / name).string());
     files_.push_back(name);
     stamps_ns_.push_back(frame.scan.stamp_ns);
+    for (const ImuSample& sample : frame.scan.imu) {
+      // A sample at the very instant where one sweep ends and the next begins may come with
+      // both frames (their bounds are sums of floating-point seconds): written once.
+      if (imu_written_ && sample.stamp_ns <= last_imu_stamp_ns_) continue;
+      append_imu_csv_line(sample, &imu_csv_);
+      imu_written_ = true;
+      last_imu_stamp_ns_ = sample.stamp_ns;
+    }
   }
   trajectory_.push_back(frame.scan.stamp_ns, T_map_sensor);
   for (const Eigen::Vector3f& p : frame.surface_points_m) {
@@ -152,6 +161,11 @@ void SimulationWriter::finish(const mesh::TriangleMesh& mesh) {
   std::ofstream yaml = open_for_writing(yaml_path);
   yaml << cloud::format_sequence_yaml(sequence);
   close_checked(yaml, yaml_path);
+  if (imu_csv_.empty()) return;
+  const std::string imu_path = (dir / "imu.csv").string();
+  std::ofstream imu = open_for_writing(imu_path);
+  imu << kImuCsvHeader << '\n' << imu_csv_;
+  close_checked(imu, imu_path);
 }
 
 }  // namespace featsense::slam

@@ -26,6 +26,13 @@ struct SensorConfig {
   /// Where packet streams (Velodyne) are cut into scans: azimuth in degrees, clockwise from
   /// +x (forward). 180 puts the seam behind the sensor.
   double scan_cut_deg = 180.0;
+  /// Read the IMU's samples where the input has them (Scan::imu); false leaves them out.
+  bool imu = true;
+  /// A bag's IMU topic; unset: the one sensor_msgs/Imu topic there is.
+  std::optional<std::string> imu_topic;
+  /// Roll, pitch, yaw (degrees) of the rotation from the IMU's frame into the sensor's, for
+  /// inputs whose IMU messages do not say it (Ouster packets take it from the metadata).
+  std::array<double, 3> imu_rotation_deg = {0.0, 0.0, 0.0};
 };
 
 enum class Backend { kAuto, kCuda, kCpu };

@@ -6,12 +6,15 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <memory>
 
 #include "cloud/cloud_file_io.hpp"
 #include "cloud/frame_naming.hpp"
 #include "cloud/text_lines.hpp"
+#include "featsense/slam/io/imu_csv.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "featsense/slam/io/sequence_file.hpp"
+#include "imu_sweep_assigner.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -89,6 +92,7 @@ class ScanFolderSource final : public ScanSource {
       }
       scan->stamp_ns = stamp_of(index, file_stamp);
       scan->sequence = index;
+      if (imu_) imu_->attach(*scan);
       count_frame();
       return scan;
     }
@@ -146,6 +150,27 @@ class ScanFolderSource final : public ScanSource {
     info_.format = "simulated";
     info_.detail =
         std::to_string(frames_.size()) + " simulated frames, sensor " + sequence.sensor.name;
+    if (options.imu) open_imu_csv();
+  }
+
+  /// The IMU's samples of imu.csv beside sequence.yaml, where there is one: small enough (a
+  /// few MB an hour) to be read at once and handed to the frames as they are read.
+  void open_imu_csv() {
+    const fs::path path = folder_ / "imu.csv";
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return;
+    std::vector<std::string> skipped;
+    size_t skipped_count = 0;
+    const std::vector<ImuSample> samples =
+        parse_imu_csv(cloud::read_file_bytes(path), path.string(), &skipped, &skipped_count);
+    for (const std::string& line : skipped) warn(line);
+    if (skipped_count > skipped.size()) {
+      warn(path.string() + ": " + std::to_string(skipped_count - skipped.size()) +
+           " more lines skipped");
+    }
+    imu_ = std::make_unique<detail::ImuSweepAssigner>(detail::sweep_duration_ns(rate_hz_));
+    for (const ImuSample& sample : samples) imu_->add(sample);
+    info_.imu = "imu.csv (" + std::to_string(samples.size()) + " samples, sensor frame)";
   }
 
   void open_scans(const SourceOptions& options) {
@@ -284,6 +309,7 @@ class ScanFolderSource final : public ScanSource {
   CloudFormat format_ = CloudFormat::kPcd;
   CloudTiming timing_;
   double rate_hz_ = 10.0;
+  std::unique_ptr<detail::ImuSweepAssigner> imu_;  ///< imu.csv's samples not handed out yet
   size_t next_ = 0;
   std::optional<Scan> first_;
   std::optional<int64_t> first_stamp_;

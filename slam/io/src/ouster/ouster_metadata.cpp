@@ -159,6 +159,17 @@ void parse_data_format(const KeyReader& format, OusterMetadata* meta) {
   meta->column_window = {window[0], window[1]};
 }
 
+/// The UDP ports where given (the sensor's defaults 7502 and 7503 otherwise).
+void parse_udp_ports(const KeyReader& holder, OusterMetadata* meta) {
+  const auto port = [&](const char* key, int* out) {
+    if (!holder.has(key)) return;
+    *out = holder.integer(key);
+    if (*out < 0 || *out > 65535) holder.fail(key, "must be a UDP port, 0 .. 65535");
+  };
+  port("udp_port_lidar", &meta->udp_port_lidar);
+  port("udp_port_imu", &meta->udp_port_imu);
+}
+
 /// Rejects metadata whose parts disagree, before anything indexes with them.
 void validate(const OusterMetadata& meta, const std::string& origin) {
   const auto fail = [&](const std::string& what) { throw InputError(origin + ": " + what); };
@@ -204,9 +215,22 @@ void validate(const OusterMetadata& meta, const std::string& origin) {
   if (!(std::abs(meta.lidar_origin_to_beam_origin_mm) < 1000.0)) {
     fail("lidar_origin_to_beam_origin_mm must be below 1 m");
   }
-  for (const auto* matrix : {&meta.beam_to_lidar, &meta.lidar_to_sensor}) {
+  for (const auto* matrix : {&meta.beam_to_lidar, &meta.lidar_to_sensor, &meta.imu_to_sensor}) {
     for (double v : *matrix) {
       if (!std::isfinite(v) || std::abs(v) > 1.0e6) fail("a transform holds a non-finite value");
+    }
+  }
+  // The IMU's samples are turned by this matrix's rotation part, which must be one.
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      double dot = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        dot += meta.imu_to_sensor[static_cast<size_t>(4 * k + a)] *
+               meta.imu_to_sensor[static_cast<size_t>(4 * k + b)];
+      }
+      if (std::abs(dot - (a == b ? 1.0 : 0.0)) > 1.0e-3) {
+        fail("imu_to_sensor_transform's upper-left 3x3 is not a rotation");
+      }
     }
   }
 }
@@ -288,11 +312,18 @@ OusterMetadata parse_ouster_metadata(const std::string& json_text, const std::st
       meta.beam_to_lidar = beams.matrix4("beam_to_lidar_transform");
     }
     meta.lidar_to_sensor = top.object("lidar_intrinsics").matrix4("lidar_to_sensor_transform");
+    if (top.has("imu_intrinsics")) {
+      const KeyReader imu = top.object("imu_intrinsics");
+      if (imu.has("imu_to_sensor_transform")) {
+        meta.imu_to_sensor = imu.matrix4("imu_to_sensor_transform");
+      }
+    }
     const KeyReader format = top.object("lidar_data_format");
     parse_data_format(format, &meta);
     const KeyReader config = top.object("config_params");
     meta.lidar_mode = config.string("lidar_mode");
     mode_holder = config;
+    parse_udp_ports(config, &meta);
     meta.prod_line = top.object("sensor_info").string("prod_line");
     // Firmware writes the profile into lidar_data_format, older nested files only into
     // config_params; absent means the legacy packet format.
@@ -306,6 +337,10 @@ OusterMetadata parse_ouster_metadata(const std::string& json_text, const std::st
     meta.beam_azimuth_deg = top.numbers("beam_azimuth_angles");
     meta.lidar_origin_to_beam_origin_mm = top.number("lidar_origin_to_beam_origin_mm");
     meta.lidar_to_sensor = top.matrix4("lidar_to_sensor_transform");
+    if (top.has("imu_to_sensor_transform")) {
+      meta.imu_to_sensor = top.matrix4("imu_to_sensor_transform");
+    }
+    parse_udp_ports(top, &meta);
     if (top.has("beam_to_lidar_transform")) {
       meta.beam_to_lidar = top.matrix4("beam_to_lidar_transform");
     }

@@ -1,6 +1,7 @@
 // An Ouster recording in a pcap file plus its metadata JSON, read as a stream of scans.
 
 #include <algorithm>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -10,6 +11,8 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/io/ouster_frame_assembler.hpp"
 #include "featsense/slam/io/readers.hpp"
+#include "imu_sweep_assigner.hpp"
+#include "ouster/ouster_imu_packet.hpp"
 #include "ouster/pcap_udp_reader.hpp"
 
 namespace featsense::slam {
@@ -76,14 +79,19 @@ std::unique_ptr<std::ifstream> open_pcap_stream(const std::string& path,
 
 class OusterPcapSource final : public ScanSource {
  public:
-  OusterPcapSource(const std::string& path, const fs::path& meta_path, OusterMetadata metadata)
+  OusterPcapSource(const std::string& path, const fs::path& meta_path, OusterMetadata metadata,
+                   bool read_imu)
       : stream_(open_pcap_stream(path, &stream_buffer_)),
         udp_(*stream_, path),
         assembler_(std::move(metadata)),
+        imu_(detail::sweep_duration_ns(assembler_.metadata().rate_hz)),
+        read_imu_(read_imu),
         path_(path),
         meta_path_(meta_path.string()) {
     const OusterMetadata& meta = assembler_.metadata();
     packet_size_ = meta.packet_size();
+    imu_port_ = meta.udp_port_imu;
+    imu_to_sensor_ = detail::ouster_imu_to_sensor_rotation(meta);
     info_.format = "ouster-pcap";
     info_.path = path;
     info_.sensor = meta.sensor_model();
@@ -97,20 +105,66 @@ class OusterPcapSource final : public ScanSource {
     if (meta.profile != OusterProfile::kRng15Rfl8Nir8) info_.fields.push_back("signal");
     info_.detail = meta.prod_line + " " + meta.lidar_mode + " " + to_string(meta.profile);
     info_.times = "per column, from the lidar packets' timestamps";
+    if (read_imu_) {
+      info_.imu = "the IMU packets on UDP port " + std::to_string(imu_port_) +
+                  ", turned into the sensor frame by the metadata's imu_to_sensor_transform";
+    }
   }
 
   std::optional<Scan> next() override {
-    if (ended_) return std::nullopt;
-    while (std::optional<detail::UdpDatagram> datagram = udp_.next()) {
-      if (datagram->size != packet_size_) {
-        note_other_size(*datagram);
-        continue;
+    for (;;) {
+      // A completed frame waits until the IMU's samples of its sweep have come (they may
+      // follow the next frame's first lidar packet), at most until the next frame completes.
+      if (!pending_.empty() && (ended_ || !read_imu_ || imu_.received() == 0 ||
+                                pending_.size() > 1 || imu_.covers(pending_.front()))) {
+        Scan scan = std::move(pending_.front());
+        pending_.pop_front();
+        return deliver(std::move(scan));
       }
+      if (ended_) {
+        if (stats().frames_read == 0) throw InputError(no_frames_message());
+        if (!imu_checked_) {
+          imu_checked_ = true;
+          const std::string mismatch = detail::clock_mismatch_warning(imu_, path_);
+          if (!mismatch.empty()) warn(mismatch);
+        }
+        return std::nullopt;
+      }
+      read_datagram();
+    }
+  }
+
+  const SourceInfo& info() const override { return info_; }
+
+ private:
+  /// Reads one UDP datagram: a lidar packet goes to the assembler (a completed frame to
+  /// pending_), an IMU packet to the IMU's samples; at the end of the capture the frame in
+  /// progress completes.
+  void read_datagram() {
+    std::optional<detail::UdpDatagram> datagram = udp_.next();
+    if (!datagram) {
+      end_of_capture();
+      return;
+    }
+    if (datagram->size == packet_size_) {
       ++lidar_packets_;
       if (std::optional<Scan> scan = assembler_.add_packet(datagram->payload, datagram->size)) {
-        return deliver(std::move(*scan));
+        pending_.push_back(std::move(*scan));
       }
+      return;
     }
+    if (read_imu_ && datagram->destination_port == imu_port_) {
+      if (std::optional<ImuSample> sample =
+              detail::decode_ouster_imu_packet(datagram->payload, datagram->size, imu_to_sensor_)) {
+        imu_.add(*sample);
+        return;
+      }
+      ++malformed_imu_packets_;
+    }
+    note_other_size(*datagram);
+  }
+
+  void end_of_capture() {
     ended_ = true;
     if (udp_.problem()) warn(*udp_.problem());
     if (udp_.stats().malformed > 0) {
@@ -121,16 +175,18 @@ class OusterPcapSource final : public ScanSource {
       warn(path_ + ": " + std::to_string(udp_.incomplete_datagrams()) +
            " fragmented IP datagrams could not be reassembled (fragments missing)");
     }
-    if (std::optional<Scan> scan = assembler_.flush()) return deliver(std::move(*scan));
-    if (stats().frames_read == 0) throw InputError(no_frames_message());
-    return std::nullopt;
+    if (malformed_imu_packets_ > 0) {
+      warn(path_ + ": " + std::to_string(malformed_imu_packets_) + " packets on the IMU port " +
+           std::to_string(imu_port_) + " were not " +
+           std::to_string(detail::kOusterImuPacketBytes) +
+           "-byte IMU packets of finite values; skipped");
+    }
+    if (std::optional<Scan> scan = assembler_.flush()) pending_.push_back(std::move(*scan));
   }
 
-  const SourceInfo& info() const override { return info_; }
-
- private:
   Scan deliver(Scan scan) {
     scan.sequence = stats().frames_read;
+    if (read_imu_) imu_.attach(scan);
     if (assembler_.incomplete_frames() > incomplete_seen_) {
       incomplete_seen_ = assembler_.incomplete_frames();
       warn(path_ + ": frame " + std::to_string(scan.sequence) +
@@ -181,6 +237,12 @@ class OusterPcapSource final : public ScanSource {
   std::unique_ptr<std::ifstream> stream_;
   detail::PcapUdpReader udp_;
   OusterFrameAssembler assembler_;
+  std::deque<Scan> pending_;  ///< completed frames not handed out yet
+  detail::ImuSweepAssigner imu_;
+  bool read_imu_ = true;
+  int imu_port_ = 0;
+  Eigen::Matrix3d imu_to_sensor_ = Eigen::Matrix3d::Identity();
+  size_t malformed_imu_packets_ = 0;
   std::string path_;
   std::string meta_path_;
   SourceInfo info_;
@@ -188,6 +250,7 @@ class OusterPcapSource final : public ScanSource {
   size_t lidar_packets_ = 0;
   size_t incomplete_seen_ = 0;
   bool ended_ = false;
+  bool imu_checked_ = false;
   std::map<size_t, std::pair<size_t, uint16_t>> other_sizes_;  ///< size -> (count, port)
 };
 
@@ -198,7 +261,7 @@ std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path,
   // The metadata describes this very unit, so it wins over options.sensor_preset.
   const fs::path meta_path = options.meta_path ? fs::path(*options.meta_path) : find_metadata(path);
   OusterMetadata metadata = parse_ouster_metadata(read_text_file(meta_path), meta_path.string());
-  return std::make_unique<OusterPcapSource>(path, meta_path, std::move(metadata));
+  return std::make_unique<OusterPcapSource>(path, meta_path, std::move(metadata), options.imu);
 }
 
 }  // namespace featsense::slam

@@ -1,6 +1,6 @@
 #pragma once
 /// The interface between the bag source, which streams the messages of one topic, and the
-/// decoder of that topic's message type.
+/// decoder of that topic's message type (scans, or the IMU's samples).
 
 #include <functional>
 #include <memory>
@@ -8,6 +8,7 @@
 #include <string>
 
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/imu_sample.hpp"
 #include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/scan.hpp"
 #include "featsense/slam/scan_source.hpp"
@@ -47,6 +48,16 @@ struct BagTopicContext {
 using SensorLookup =
     std::function<config::SensorModel(const SourceOptions& options, const std::string& fallback)>;
 
+/// Turns one message of an IMU topic (sensor_msgs/Imu, Ouster's IMU packets) into a sample.
+class ImuMessageDecoder {
+ public:
+  virtual ~ImuMessageDecoder() = default;
+  /// The sample of one message, in the sensor frame and the scans' clock; a message that
+  /// cannot be decoded is reported and yields nothing.
+  virtual std::optional<ImuSample> decode(const BagMessage& message,
+                                          const DecodeReport& report) = 0;
+};
+
 /// Turns the messages of one topic, in file order, into scans.
 class BagScanDecoder {
  public:
@@ -59,6 +70,9 @@ class BagScanDecoder {
   /// A further scan completed by the last message or finish() (a message of many packets
   /// may complete several); asked for until it returns nullopt.
   virtual std::optional<Scan> take_pending() { return std::nullopt; }
+  /// The decoder of the IMU packets recorded beside these scans' packets, which need the same
+  /// sensor description (Ouster's metadata); nullptr for other message types.
+  virtual std::unique_ptr<ImuMessageDecoder> packet_imu_decoder() const { return nullptr; }
 };
 
 }  // namespace featsense::slam

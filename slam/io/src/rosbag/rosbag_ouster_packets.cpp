@@ -7,7 +7,9 @@
 
 #include "featsense/slam/io/ouster_frame_assembler.hpp"
 #include "featsense/slam/io/ouster_metadata.hpp"
+#include "ouster/ouster_imu_packet.hpp"
 #include "rosbag/bag_catalog.hpp"
+#include "rosbag/bag_scan_decoder.hpp"
 #include "rosbag/bag_topic_choice.hpp"
 #include "rosbag/ros_serialization.hpp"
 #include "rosbag/simple_messages.hpp"
@@ -22,6 +24,38 @@ std::string read_text_file(const std::string& path) {
   text << file.rdbuf();
   return text.str();
 }
+
+/// The payload of each PacketMsg of an IMU packet topic, decoded as the pcap reader does.
+class OusterImuPacketDecoder final : public ImuMessageDecoder {
+ public:
+  OusterImuPacketDecoder(const OusterMetadata& metadata, MessageEncoding encoding)
+      : imu_to_sensor_(detail::ouster_imu_to_sensor_rotation(metadata)), encoding_(encoding) {}
+
+  std::optional<ImuSample> decode(const BagMessage& message, const DecodeReport& report) override {
+    ByteView payload;
+    try {
+      payload = byte_array_message(message.data, encoding_);
+    } catch (const SerializationError& e) {
+      report.warn("IMU packet at offset " + std::to_string(message.offset) + ": " + e.what());
+      return std::nullopt;
+    }
+    std::optional<ImuSample> sample =
+        detail::decode_ouster_imu_packet(payload.data, payload.size, imu_to_sensor_);
+    if (!sample) {
+      report.warn("IMU packet at offset " + std::to_string(message.offset) +
+                  (payload.size == detail::kOusterImuPacketBytes
+                       ? std::string(" holds a non-finite value")
+                       : " has " + std::to_string(payload.size) + " bytes, not " +
+                             std::to_string(detail::kOusterImuPacketBytes)) +
+                  "; ignored");
+    }
+    return sample;
+  }
+
+ private:
+  Eigen::Matrix3d imu_to_sensor_;
+  MessageEncoding encoding_;
+};
 
 /// Feeds the payload of each PacketMsg to the frame assembler; scans come out as frames
 /// complete.
@@ -56,6 +90,11 @@ class OusterPacketDecoder final : public BagScanDecoder {
                   " lidar packets rejected by the decoder");
     }
     return scan;
+  }
+
+  std::unique_ptr<ImuMessageDecoder> packet_imu_decoder() const override {
+    // The IMU topic is written by the same driver as the lidar topic, in the same encoding.
+    return std::make_unique<OusterImuPacketDecoder>(assembler_.metadata(), encoding_);
   }
 
  private:

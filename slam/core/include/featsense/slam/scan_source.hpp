@@ -32,6 +32,9 @@ struct SourceInfo {
   /// Where the per-point times come from, one line for humans: "per-point field 't'",
   /// "from the azimuth (...)", "none: why"; as the first frame had them.
   std::string times;
+  /// Where the IMU's samples (Scan::imu) come from and in which frame, one line for humans;
+  /// empty where the recording has none or they are not read.
+  std::string imu;
   /// Recordings of several topics (bags, MCAP): each as "name (type, encoding, N messages)".
   std::vector<std::string> topics;
 };

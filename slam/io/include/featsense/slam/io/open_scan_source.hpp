@@ -1,6 +1,7 @@
 #pragma once
 /// Opening a recording of any supported format, detected from its content.
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,6 +26,14 @@ struct SourceOptions {
   /// Config key sensor.scan_cut_deg: the azimuth (degrees clockwise from +x) where packet
   /// streams (Velodyne) are cut into scans.
   double scan_cut_deg = config::SensorConfig{}.scan_cut_deg;
+  /// Config key sensor.imu: deliver the IMU's samples with each scan (Scan::imu) where the
+  /// input has them.
+  bool imu = config::SensorConfig{}.imu;
+  /// Config key sensor.imu_topic: a bag's IMU topic (else the one sensor_msgs/Imu topic).
+  std::optional<std::string> imu_topic;
+  /// Config key sensor.imu_rotation: roll, pitch, yaw (degrees) from the IMU frame into the
+  /// sensor frame, for IMU messages that do not carry it (sensor_msgs/Imu).
+  std::array<double, 3> imu_rotation_deg = config::SensorConfig{}.imu_rotation_deg;
 };
 
 /// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the

@@ -26,7 +26,11 @@ struct OusterMetadata {
   double lidar_origin_to_beam_origin_mm = 0.0;
   std::array<double, 16> beam_to_lidar = {};    ///< row-major 4x4, translation in mm
   std::array<double, 16> lidar_to_sensor = {};  ///< row-major 4x4, translation in mm
-  double rate_hz = 10.0;                        ///< from lidar_mode
+  /// Row-major 4x4, translation in mm; identity where the metadata has none.
+  std::array<double, 16> imu_to_sensor = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  int udp_port_lidar = 7502;  ///< the sensor's defaults where the metadata names none
+  int udp_port_imu = 7503;
+  double rate_hz = 10.0;  ///< from lidar_mode
 
   /// Bytes of one lidar packet of this profile and geometry.
   size_t packet_size() const;

@@ -14,7 +14,10 @@ namespace featsense::slam {
 /// whose name shares the longest prefix with the pcap's. Lidar packets are the UDP payloads of
 /// the size the metadata implies, on any port. A capture that yields no frame at all (no such
 /// packet, or cut before the first) throws InputError from next(), naming the sizes it saw; a
-/// capture cut later ends with a counted warning after the frames before the cut.
+/// capture cut later ends with a counted warning after the frames before the cut. With
+/// options.imu, the IMU packets on the metadata's udp_port_imu go with the scan of their
+/// sweep (Scan::imu), turned into the sensor frame by its imu_to_sensor_transform; a packet
+/// of another size there is skipped with a counted warning.
 std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path, const SourceOptions& options);
 /// A Velodyne pcap (VeloView or tcpdump): the 1206-byte UDP data packets of a VLP-16,
 /// VLP-32C, HDL-32E, HDL-64E or VLS-128, decoded with sensor.calibration (else the model's
@@ -24,7 +27,8 @@ std::unique_ptr<ScanSource> open_velodyne_pcap(const std::string& path,
 /// True where the first UDP datagrams of a pcap include a Velodyne data packet.
 bool is_velodyne_pcap(const std::string& path);
 /// A ROS1 bag (format 2.0): sensor_msgs/PointCloud2, velodyne_msgs/VelodyneScan or raw
-/// ouster_ros/PacketMsg topics.
+/// ouster_ros/PacketMsg topics. With options.imu, the IMU's samples (Ouster IMU packets, or
+/// a sensor_msgs/Imu topic: bag_imu_topic.hpp) go with the scan of their sweep.
 std::unique_ptr<ScanSource> open_rosbag(const std::string& path, const SourceOptions& options);
 /// A ROS 2 bag: its folder (metadata.yaml + .db3 or .mcap files, read in the order the
 /// metadata lists them) or one .db3 file. Topics as in open_rosbag(), serialized as CDR.

@@ -3,6 +3,7 @@
 /// slam/io/src/cloud/SEQUENCE_FORMAT.md) and its ground truth:
 ///   frame_NNNNNN.pcd    one organized binary PCD per frame (ring, t, intensity channels)
 ///   sequence.yaml       index of the frames and the sensor
+///   imu.csv             the IMU's samples of every frame (where the frames carry any)
 ///   gt_trajectory.tum   T_map_sensor per frame at its stamp (column 0's time)
 ///   gt_mesh.ply         the scene's triangles, binary PLY
 ///   gt_points.ply       the noise-free surface points the sensor saw, over all frames,
@@ -30,7 +31,8 @@ class SimulationWriter {
 
   /// Writes the frame's PCD and records its stamp, ground-truth pose and surface points.
   void add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor);
-  /// Writes gt_trajectory.tum, gt_mesh.ply, gt_points.ply and (with frames) sequence.yaml.
+  /// Writes gt_trajectory.tum, gt_mesh.ply, gt_points.ply and (with frames) sequence.yaml
+  /// and imu.csv.
   void finish(const mesh::TriangleMesh& mesh);
 
   size_t ground_truth_points() const { return points_.size(); }
@@ -45,7 +47,10 @@ class SimulationWriter {
   bool write_frames_;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
-  Trajectory trajectory_;  ///< the true pose of each frame at its stamp
+  std::string imu_csv_;  ///< the lines of imu.csv so far, header excluded
+  bool imu_written_ = false;
+  int64_t last_imu_stamp_ns_ = 0;  ///< of the latest line of imu_csv_
+  Trajectory trajectory_;          ///< the true pose of each frame at its stamp
   /// Occupied voxel keys, open addressing with linear probing (0 = empty slot; keys are
   /// never 0): a node-based set spent more time than the simulation itself.
   std::vector<uint64_t> voxel_slots_;
