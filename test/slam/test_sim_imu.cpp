@@ -76,3 +76,29 @@ TEST(ImuSimulator, NoiseAndBiasAreThoseOfTheModelAndRepeatable) {
 
 }  // namespace
 }  // namespace featsense::slam
+
+namespace featsense::slam {
+namespace {
+
+TEST(ImuSimulator, ConsecutiveSweepsShareNoSample) {
+  // Frame k's window is [k / 10, k / 10 + 0.1): 0.2 + 0.1 is a rounding error above 0.3, and
+  // the sample at 0.3 s belongs to the next frame only.
+  const std::unique_ptr<PoseCurve> path = standing(Eigen::Isometry3d::Identity());
+  int64_t last_stamp = -1;
+  size_t total = 0;
+  for (int frame = 0; frame < 20; ++frame) {
+    const double start = frame * 0.1;
+    const std::vector<ImuSample> samples =
+        simulate_imu(*path, ImuModel::exact(), 1, start, start + 0.1, 0);
+    EXPECT_EQ(samples.size(), 10u) << frame;
+    for (const ImuSample& s : samples) {
+      EXPECT_GT(s.stamp_ns, last_stamp) << frame;
+      last_stamp = s.stamp_ns;
+    }
+    total += samples.size();
+  }
+  EXPECT_EQ(total, 200u);
+}
+
+}  // namespace
+}  // namespace featsense::slam

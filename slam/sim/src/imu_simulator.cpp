@@ -57,7 +57,9 @@ std::vector<ImuSample> simulate_imu(const PoseCurve& path, const ImuModel& model
   const auto first = static_cast<uint64_t>(std::ceil(t0_s * model.rate_hz - 1e-9));
   for (uint64_t k = first;; ++k) {
     const double t = static_cast<double>(k) / model.rate_hz;
-    if (t >= t1_s) break;
+    // Within a nanosecond of t1 the sample is the next window's: t1 = start + period comes
+    // out a rounding error above k / rate (0.2 + 0.1), and it would be in both.
+    if (t >= t1_s - 1e-9) break;
     // Central differences inside the path, one-sided at its ends (the path is clamped there,
     // so a centred step would see a stop that is not in it).
     const double centre = std::clamp(t, kStep_s, std::max(kStep_s, duration - kStep_s));
