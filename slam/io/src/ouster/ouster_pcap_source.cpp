@@ -216,10 +216,15 @@ class OusterPcapSource final : public ScanSource {
       message += "no lidar packets of " + std::to_string(packet_size_) + " bytes (" +
                  to_string(meta.profile) + ", " + std::to_string(meta.pixels_per_column) +
                  " pixels per column, as " + meta_path_ + " says)";
-      if (other_sizes_.empty()) {
+      const size_t imu_packets = imu_.received() + malformed_imu_packets_;
+      if (other_sizes_.empty() && imu_packets == 0) {
         message += " and no other UDP packets either";
       } else {
         message += "; UDP payloads seen:";
+        if (imu_packets > 0) {
+          message += " " + std::to_string(imu_packets) + " IMU packets (port " +
+                     std::to_string(imu_port_) + ")";
+        }
         for (const auto& [size, seen] : other_sizes_) {
           message += " " + std::to_string(seen.first) + " of " + std::to_string(size) +
                      " bytes (port " + std::to_string(seen.second) + ")";
