@@ -138,6 +138,10 @@ void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
   }
   // A checkpoint interrupted by a crash leaves its unfinished copy behind.
   if (writable_) std::filesystem::remove(with_suffix(path_, ".tmp"));
+  // An older map is rewritten in this version before anything is journalled over it: a
+  // program that reads only the older version then refuses the map rather than stopping its
+  // replay at the first record type it does not know.
+  if (writable_ && metadata_.format_version < kFormatVersion) checkpoint();
 }
 
 void Hdf5ChunkStore::require_writable(const char* what) const {
