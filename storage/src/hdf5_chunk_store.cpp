@@ -276,15 +276,18 @@ std::vector<KeyframeKey> Hdf5ChunkStore::keyframe_keys() const {
 }
 
 std::vector<StoredKeyframe> Hdf5ChunkStore::read_keyframes() const {
-  if (closed_) throw std::logic_error("read_keyframes on a closed map: " + path_.string());
   std::vector<StoredKeyframe> keyframes;
-  for (const KeyframeKey& key : keyframe_keys()) {
-    if (const auto it = unflushed_keyframes_.find(key); it != unflushed_keyframes_.end())
-      keyframes.push_back(it->second);
-    else
-      keyframes.push_back(load_keyframe(key, keyframes_.at(key)));
-  }
+  for (const KeyframeKey& key : keyframe_keys()) keyframes.push_back(*read_keyframe(key));
   return keyframes;
+}
+
+std::optional<StoredKeyframe> Hdf5ChunkStore::read_keyframe(const KeyframeKey& key) const {
+  if (closed_) throw std::logic_error("read_keyframe on a closed map: " + path_.string());
+  if (const auto it = unflushed_keyframes_.find(key); it != unflushed_keyframes_.end())
+    return it->second;
+  if (const auto it = keyframes_.find(key); it != keyframes_.end())
+    return load_keyframe(key, it->second);
+  return std::nullopt;
 }
 
 StoredKeyframe Hdf5ChunkStore::load_keyframe(const KeyframeKey& key, const Location& where) const {

@@ -16,6 +16,8 @@ namespace featsense::storage::detail {
 
 namespace {
 
+static_assert(sizeof(TrajectoryPose) == 8 * sizeof(double), "a pose is written as 8 doubles");
+
 constexpr const char* kPoseColumns = "t_s x y z qx qy qz qw";
 
 hid_t open_keyframe_dataset(hid_t file, const std::string& name,

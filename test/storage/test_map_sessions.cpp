@@ -95,6 +95,10 @@ TEST(MapSessions, RoundTripThroughCloseAndReopen) {
   const std::vector<KeyframeKey> keys = store.keyframe_keys();
   ASSERT_EQ(keys.size(), keyframes.size());
   EXPECT_TRUE(keys[5] == (KeyframeKey{0, 10}));
+  ASSERT_TRUE(store.read_keyframe({2, 4}).has_value());
+  EXPECT_TRUE(same_keyframe(*store.read_keyframe({2, 4}), odd));
+  EXPECT_FALSE(store.read_keyframe({2, 5}).has_value());
+  EXPECT_FALSE(store.read_keyframe({1, 0}).has_value());
 }
 
 TEST(MapSessions, RewritingAKeyReplacesTheKeyframe) {

@@ -77,6 +77,9 @@ class Hdf5ChunkStore final : public ChunkStore {
   void write_keyframes(const std::vector<StoredKeyframe>& keyframes);
   /// Every stored keyframe, sorted by (session, index); read from the file on each call.
   std::vector<StoredKeyframe> read_keyframes() const;
+  /// One keyframe, or nothing when none has this key: for reading a large map's keyframes
+  /// one at a time rather than all at once.
+  std::optional<StoredKeyframe> read_keyframe(const KeyframeKey& key) const;
   /// The keys of every stored keyframe, sorted, without reading the keyframes.
   std::vector<KeyframeKey> keyframe_keys() const;
   /// Replaces the sessions table (durable at the next flush). Ids must be unique and stamps
