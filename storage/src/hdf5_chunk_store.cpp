@@ -12,6 +12,7 @@
 #include "file_ops.hpp"
 #include "hdf5_map_file.hpp"
 #include "journal.hpp"
+#include "keyframe_records.hpp"
 
 namespace featsense::storage {
 
@@ -109,6 +110,8 @@ void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
     present_.insert(key);
   }
   trajectory_ = file_->read_trajectory();
+  for (const auto& key : file_->keyframe_keys()) keyframes_[key] = Location{};
+  sessions_ = file_->read_sessions();
 
   journal_ = std::make_unique<detail::Journal>(with_suffix(path_, ".journal"), writable_, false);
   for (const auto& record : journal_->replay()) {
@@ -117,6 +120,14 @@ void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
       trajectory_.resize(bytes.size() / sizeof(TrajectoryPose));
       if (!trajectory_.empty())
         std::memcpy(trajectory_.data(), bytes.data(), trajectory_.size() * sizeof(TrajectoryPose));
+    } else if (record.type == detail::RecordType::kKeyframe) {
+      // Keyed, not appended: records replayed again after a checkpoint that was cut short
+      // before the journal was emptied replace the same keyframes.
+      keyframes_[detail::keyframe_key_of_record(record.key)] =
+          Location{true, record.payload_offset, record.payload_size};
+    } else if (record.type == detail::RecordType::kSessions) {
+      sessions_ = detail::decode_sessions(
+          journal_->read_payload(record.payload_offset, record.payload_size), journal_->path());
     } else if (record.payload_size == 0) {
       stored_.erase(record.key);
       present_.erase(record.key);
@@ -127,6 +138,10 @@ void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
   }
   // A checkpoint interrupted by a crash leaves its unfinished copy behind.
   if (writable_) std::filesystem::remove(with_suffix(path_, ".tmp"));
+  // An older map is rewritten in this version before anything is journalled over it: a
+  // program that reads only the older version then refuses the map rather than stopping its
+  // replay at the first record type it does not know.
+  if (writable_ && metadata_.format_version < kFormatVersion) checkpoint();
 }
 
 void Hdf5ChunkStore::require_writable(const char* what) const {
@@ -247,6 +262,72 @@ void Hdf5ChunkStore::write_trajectory(const std::vector<TrajectoryPose>& poses) 
   trajectory_dirty_ = true;
 }
 
+void Hdf5ChunkStore::write_keyframes(const std::vector<StoredKeyframe>& keyframes) {
+  require_writable("write_keyframes");
+  for (const StoredKeyframe& keyframe : keyframes) detail::check_keyframe(keyframe, path_);
+  for (const StoredKeyframe& keyframe : keyframes) unflushed_keyframes_[keyframe.key()] = keyframe;
+}
+
+std::vector<KeyframeKey> Hdf5ChunkStore::keyframe_keys() const {
+  std::set<KeyframeKey> keys;
+  for (const auto& [key, where] : keyframes_) keys.insert(key);
+  for (const auto& [key, keyframe] : unflushed_keyframes_) keys.insert(key);
+  return std::vector<KeyframeKey>(keys.begin(), keys.end());
+}
+
+std::vector<StoredKeyframe> Hdf5ChunkStore::read_keyframes() const {
+  std::vector<StoredKeyframe> keyframes;
+  for (const KeyframeKey& key : keyframe_keys()) keyframes.push_back(*read_keyframe(key));
+  return keyframes;
+}
+
+std::optional<StoredKeyframe> Hdf5ChunkStore::read_keyframe(const KeyframeKey& key) const {
+  if (closed_) throw std::logic_error("read_keyframe on a closed map: " + path_.string());
+  if (const auto it = unflushed_keyframes_.find(key); it != unflushed_keyframes_.end())
+    return it->second;
+  if (const auto it = keyframes_.find(key); it != keyframes_.end())
+    return load_keyframe(key, it->second);
+  return std::nullopt;
+}
+
+StoredKeyframe Hdf5ChunkStore::load_keyframe(const KeyframeKey& key, const Location& where) const {
+  if (!where.in_journal) return file_->read_keyframe(key);
+  StoredKeyframe keyframe =
+      detail::decode_keyframe(journal_->read_payload(where.offset, where.size), journal_->path());
+  if (!(keyframe.key() == key))
+    throw std::runtime_error("damaged keyframe record in " + journal_->path().string());
+  return keyframe;
+}
+
+void Hdf5ChunkStore::write_sessions(const std::vector<MapSession>& sessions) {
+  require_writable("write_sessions");
+  detail::check_sessions(sessions, path_);
+  sessions_ = sessions;
+  std::sort(sessions_.begin(), sessions_.end(),
+            [](const MapSession& a, const MapSession& b) { return a.id < b.id; });
+  sessions_dirty_ = true;
+}
+
+void Hdf5ChunkStore::journal_keyframes_and_sessions() {
+  for (auto it = unflushed_keyframes_.begin(); it != unflushed_keyframes_.end();) {
+    const auto payload = detail::encode_keyframe(it->second);
+    const uint64_t offset =
+        journal_->append(detail::RecordType::kKeyframe, detail::record_key_of(it->first), payload);
+    keyframes_[it->first] = Location{true, offset, static_cast<uint32_t>(payload.size())};
+    // Erased one by one: after a failed append the rest stay unflushed, as dirty chunks do.
+    it = unflushed_keyframes_.erase(it);
+  }
+  if (sessions_dirty_) {
+    journal_->append(detail::RecordType::kSessions, {}, detail::encode_sessions(sessions_));
+    sessions_dirty_ = false;
+  }
+}
+
+bool Hdf5ChunkStore::has_unflushed_writes() const {
+  return trajectory_dirty_ || sessions_dirty_ || !unflushed_keyframes_.empty() ||
+         std::any_of(cache_.begin(), cache_.end(), [](const auto& kv) { return kv.second.dirty; });
+}
+
 void Hdf5ChunkStore::flush() {
   if (closed_ || !writable_) return;
   std::vector<ChunkKey> dirty;
@@ -259,14 +340,14 @@ void Hdf5ChunkStore::flush() {
     journal_->append(detail::RecordType::kTrajectory, {}, trajectory_bytes(trajectory_));
     trajectory_dirty_ = false;
   }
+  journal_keyframes_and_sessions();
   journal_->sync();
   if (journal_->size_bytes() > settings_.journal_limit_bytes) checkpoint();
 }
 
 void Hdf5ChunkStore::checkpoint() {
   require_writable("checkpoint");
-  if (trajectory_dirty_ ||
-      std::any_of(cache_.begin(), cache_.end(), [](const auto& kv) { return kv.second.dirty; })) {
+  if (has_unflushed_writes()) {
     // Only the journal and the old file are copied below, so everything must be in them.
     const std::size_t limit = settings_.journal_limit_bytes;
     settings_.journal_limit_bytes = SIZE_MAX;
@@ -289,6 +370,13 @@ void Hdf5ChunkStore::checkpoint() {
         writer.copy_chunk(*file_, key);
     }
     writer.write_trajectory(trajectory_);
+    for (const auto& [key, where] : keyframes_) {
+      if (where.in_journal)
+        writer.write_keyframe(load_keyframe(key, where));
+      else
+        writer.copy_keyframe(*file_, key);
+    }
+    writer.write_sessions(sessions_);
     writer.close();
   } catch (...) {
     std::error_code ignored;
@@ -301,6 +389,8 @@ void Hdf5ChunkStore::checkpoint() {
   file_ = std::make_unique<detail::Hdf5MapReader>(path_);
   journal_->reset();
   for (auto& [key, where] : stored_) where = Location{};
+  for (auto& [key, where] : keyframes_) where = Location{};
+  metadata_.format_version = kFormatVersion;
 }
 
 void Hdf5ChunkStore::close() {

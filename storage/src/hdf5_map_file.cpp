@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "file_ops.hpp"
+#include "hdf5_helpers.hpp"
 
 namespace featsense::storage::detail {
 
@@ -23,79 +24,6 @@ void silence_hdf5() {
     return true;
   }();
   (void)once;
-}
-
-[[noreturn]] void fail(const std::string& what, const std::filesystem::path& path) {
-  throw std::runtime_error(what + " (" + path.string() + ")");
-}
-
-/// Closes an HDF5 identifier when it goes out of scope.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
-
-void write_attribute(hid_t object, const char* name, hid_t file_type, hid_t memory_type,
-                     const void* value, const std::filesystem::path& path) {
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  Handle attribute(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                   H5Aclose);
-  if (!attribute.valid() || H5Awrite(attribute.get(), memory_type, value) < 0)
-    fail(std::string("cannot write attribute ") + name, path);
-}
-
-void write_string_attribute(hid_t object, const char* name, const std::string& value,
-                            const std::filesystem::path& path) {
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
-  // Fixed length (at least 1: HDF5 has no empty fixed strings), padded with NULs.
-  H5Tset_size(type.get(), value.empty() ? 1 : value.size());
-  H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
-  const std::string padded = value.empty() ? std::string(1, '\0') : value;
-  write_attribute(object, name, type.get(), type.get(), padded.data(), path);
-}
-
-/// The attribute's identifier (the caller closes it); throws when it is missing.
-hid_t open_attribute(hid_t object, const char* name, const std::filesystem::path& path) {
-  if (H5Aexists(object, name) <= 0)
-    fail(std::string("not a featsense map: attribute '") + name + "' is missing", path);
-  const hid_t attribute = H5Aopen(object, name, H5P_DEFAULT);
-  if (attribute < 0) fail(std::string("cannot open attribute ") + name, path);
-  return attribute;
-}
-
-template <typename T>
-T read_number_attribute(hid_t object, const char* name, hid_t memory_type,
-                        const std::filesystem::path& path) {
-  Handle attribute(open_attribute(object, name, path), H5Aclose);
-  T value{};
-  if (H5Aread(attribute.get(), memory_type, &value) < 0)
-    fail(std::string("cannot read attribute ") + name, path);
-  return value;
-}
-
-std::string read_string_attribute(hid_t object, const char* name,
-                                  const std::filesystem::path& path) {
-  Handle attribute(open_attribute(object, name, path), H5Aclose);
-  Handle type(H5Aget_type(attribute.get()), H5Tclose);
-  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) > 0)
-    fail(std::string("attribute ") + name + " is not a fixed-length string", path);
-  std::string value(H5Tget_size(type.get()), '\0');
-  if (H5Aread(attribute.get(), type.get(), value.data()) < 0)
-    fail(std::string("cannot read attribute ") + name, path);
-  value.resize(
-      value.find_last_not_of('\0') == std::string::npos ? 0 : value.find_last_not_of('\0') + 1);
-  return value;
 }
 
 }  // namespace
@@ -122,9 +50,11 @@ Hdf5MapReader::Hdf5MapReader(const std::filesystem::path& path) : path_(path) {
 
   metadata_.format_version =
       read_number_attribute<int32_t>(file_, "format_version", H5T_NATIVE_INT32, path);
-  if (metadata_.format_version != kFormatVersion)
+  if (metadata_.format_version < kOldestReadFormatVersion ||
+      metadata_.format_version > kFormatVersion)
     fail("map format version " + std::to_string(metadata_.format_version) +
-             ", this program reads version " + std::to_string(kFormatVersion),
+             ", this program reads versions " + std::to_string(kOldestReadFormatVersion) + " to " +
+             std::to_string(kFormatVersion),
          path);
   metadata_.voxel_size_m =
       read_number_attribute<double>(file_, "voxel_size_m", H5T_NATIVE_DOUBLE, path);
@@ -147,17 +77,7 @@ Hdf5MapReader::Hdf5MapReader(const std::filesystem::path& path) : path_(path) {
 
   Handle chunks(H5Gopen2(file_, "/chunks", H5P_DEFAULT), H5Gclose);
   if (!chunks.valid()) fail("not a featsense map: group /chunks is missing", path);
-  H5G_info_t info;
-  if (H5Gget_info(chunks.get(), &info) < 0) fail("cannot list /chunks", path);
-  keys_.reserve(info.nlinks);
-  for (hsize_t i = 0; i < info.nlinks; ++i) {
-    const ssize_t length = H5Lget_name_by_idx(chunks.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i,
-                                              nullptr, 0, H5P_DEFAULT);
-    if (length < 0) fail("cannot list /chunks", path);
-    std::string name(static_cast<std::size_t>(length) + 1, '\0');
-    H5Lget_name_by_idx(chunks.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, name.data(), name.size(),
-                       H5P_DEFAULT);
-    name.resize(static_cast<std::size_t>(length));
+  for (const std::string& name : member_names(chunks.get(), "/chunks", path)) {
     const auto key = parse_chunk_name(name);
     if (!key) fail("unexpected object /chunks/" + name + " (names are x_y_z)", path);
     keys_.push_back(*key);
@@ -213,12 +133,13 @@ std::vector<TrajectoryPose> Hdf5MapReader::read_trajectory() const {
 
 Hdf5MapWriter::Hdf5MapWriter(const std::filesystem::path& path, const MapMetadata& metadata,
                              int deflate_level)
-    : path_(path) {
+    : path_(path), deflate_level_(deflate_level) {
   silence_hdf5();
   file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   if (file_ < 0) fail("cannot create the map file (directory missing or not writable?)", path);
-  write_attribute(file_, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT32,
-                  &metadata.format_version, path);
+  // Always this program's version: a continued older map is rewritten in today's layout.
+  const int32_t version = kFormatVersion;
+  write_attribute(file_, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT32, &version, path);
   write_attribute(file_, "voxel_size_m", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &metadata.voxel_size_m,
                   path);
   write_attribute(file_, "truncation_m", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &metadata.truncation_m,
@@ -236,7 +157,11 @@ Hdf5MapWriter::Hdf5MapWriter(const std::filesystem::path& path, const MapMetadat
   chunks_ = H5Gcreate2(file_, "/chunks", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   Handle trajectory(H5Gcreate2(file_, "/trajectory", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                     H5Gclose);
-  if (chunks_ < 0 || !trajectory.valid()) fail("cannot create the map's groups", path);
+  Handle keyframes(H5Gcreate2(file_, "/keyframes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                   H5Gclose);
+  Handle sessions(H5Gcreate2(file_, "/sessions", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (chunks_ < 0 || !trajectory.valid() || !keyframes.valid() || !sessions.valid())
+    fail("cannot create the map's groups", path);
 
   // One HDF5 chunk per map chunk; shuffle groups the bytes of the weights and values so that
   // deflate finds the runs of equal high bytes.

@@ -9,6 +9,7 @@
 
 #include "featsense/storage/chunk.hpp"
 #include "featsense/storage/chunk_store.hpp"
+#include "featsense/storage/map_sessions.hpp"
 
 namespace featsense::storage::detail {
 
@@ -27,6 +28,12 @@ class Hdf5MapReader {
   /// Throws when the dataset is missing or not uint32 [64][64][64].
   Chunk read(const ChunkKey& key) const;
   std::vector<TrajectoryPose> read_trajectory() const;
+  /// Every keyframe in /keyframes, sorted; none when the group is absent (older files).
+  std::vector<KeyframeKey> keyframe_keys() const;
+  /// Throws when a dataset is missing, of the wrong type or shape, or the pose is not finite.
+  StoredKeyframe read_keyframe(const KeyframeKey& key) const;
+  /// Sorted by id; none when /sessions is absent (older files).
+  std::vector<MapSession> read_sessions() const;
   int64_t handle() const { return file_; }
   const std::filesystem::path& path() const { return path_; }
 
@@ -49,6 +56,10 @@ class Hdf5MapWriter {
   /// Copies a chunk dataset as stored (still compressed) from another map file.
   void copy_chunk(const Hdf5MapReader& source, const ChunkKey& key);
   void write_trajectory(const std::vector<TrajectoryPose>& poses);
+  void write_keyframe(const StoredKeyframe& keyframe);
+  /// Copies a keyframe's group as stored (the cloud still compressed) from another map file.
+  void copy_keyframe(const Hdf5MapReader& source, const KeyframeKey& key);
+  void write_sessions(const std::vector<MapSession>& sessions);
   void close();
 
  private:
@@ -56,6 +67,7 @@ class Hdf5MapWriter {
   int64_t file_ = -1;
   int64_t chunks_ = -1;
   int64_t dcpl_ = -1;
+  int deflate_level_ = 1;
 };
 
 /// "x_y_z", the dataset name of a chunk.

@@ -19,8 +19,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the journal is little-
 
 constexpr std::array<char, 8> kFileMagic = {'F', 'S', 'J', 'R', 'N', 'L', '0', '1'};
 constexpr uint32_t kRecordMagic = 0x4B4E4843u;  // "CHNK" in little-endian bytes
-/// A record's payload is at most a compressed chunk (zlib's bound on 1 MiB) or a trajectory;
-/// anything larger is a torn or foreign size field.
+/// A record's payload is at most a compressed chunk (zlib's bound on 1 MiB), a trajectory, a
+/// keyframe or a sessions table; anything larger is a torn or foreign size field.
 constexpr uint32_t kMaxPayload = 1u << 30;
 
 struct RecordHeader {
@@ -80,8 +80,8 @@ std::vector<JournalRecord> Journal::replay() {
         static_cast<ssize_t>(sizeof(header)))
       break;
     if (header.magic != kRecordMagic || header.payload_size > kMaxPayload ||
-        (header.type != static_cast<uint32_t>(RecordType::kChunk) &&
-         header.type != static_cast<uint32_t>(RecordType::kTrajectory)))
+        header.type < static_cast<uint32_t>(RecordType::kChunk) ||
+        header.type > static_cast<uint32_t>(RecordType::kSessions))
       break;
     const uint64_t payload_offset = position + sizeof(header);
     const uint64_t record_end = payload_offset + header.payload_size + 4;

@@ -1,7 +1,7 @@
 #pragma once
-/// The append-only journal beside the .h5 (`<map>.h5.journal`, layout in FORMAT.md): chunks
-/// flushed since the last checkpoint. Records end in a CRC-32, so a record torn by a crash
-/// is recognised and dropped with everything after it.
+/// The append-only journal beside the .h5 (`<map>.h5.journal`, layout in FORMAT.md): chunks,
+/// trajectories, keyframes and session tables flushed since the last checkpoint. Records end in
+/// a CRC-32, so a record torn by a crash is recognised and dropped with everything after it.
 
 #include <cstddef>
 #include <cstdint>
@@ -12,7 +12,9 @@
 
 namespace featsense::storage::detail {
 
-enum class RecordType : uint32_t { kChunk = 1, kTrajectory = 2 };
+/// kKeyframe: one keyframe, keyed (session, index) in the record key's x and y; a later record
+/// of the same key replaces it. kSessions: the whole sessions table; the last one wins.
+enum class RecordType : uint32_t { kChunk = 1, kTrajectory = 2, kKeyframe = 3, kSessions = 4 };
 
 struct JournalRecord {
   RecordType type = RecordType::kChunk;

@@ -1,6 +1,7 @@
-// A real crash: a child process writes and flushes chunks in a loop, reporting each flushed
-// key through a pipe, and is killed with SIGKILL mid-run (also during checkpoints, which a
-// small journal limit makes frequent). Every reported chunk must be in the reopened map.
+// A real crash: a child process writes and flushes chunks and keyframes in a loop, reporting
+// each flushed step through a pipe, and is killed with SIGKILL mid-run (also during
+// checkpoints, which a small journal limit makes frequent). Every reported chunk and keyframe
+// must be in the reopened map.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <set>
 #include <utility>
+#include <vector>
 
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
@@ -19,6 +21,8 @@ namespace featsense::storage {
 namespace {
 
 using test::make_chunk;
+using test::make_keyframe;
+using test::same_keyframe;
 using test::test_metadata;
 
 /// The i-th key the child writes, spread over negative and positive coordinates.
@@ -38,6 +42,7 @@ StoreSettings child_settings(std::size_t journal_limit_bytes) {
                          child_settings(journal_limit_bytes));
     for (int32_t i = 0; i < 100000; ++i) {
       store.write(key_of(i), make_chunk(static_cast<uint32_t>(i)));
+      store.write_keyframes({make_keyframe(0, static_cast<uint32_t>(i), 500)});
       store.flush();
       if (::write(report_fd, &i, sizeof(i)) != sizeof(i)) ::_exit(3);
     }
@@ -94,6 +99,17 @@ void check_crash(const std::string& name, std::size_t journal_limit_bytes, int r
     const int32_t i = (key.x + 2) + 5 * (key.y + 2) + 25 * (key.z + 2);
     EXPECT_TRUE(*store.read(key) == make_chunk(static_cast<uint32_t>(i))) << "chunk " << i;
   }
+  // The keyframe of each step was flushed with its chunk.
+  const std::vector<StoredKeyframe> keyframes = store.read_keyframes();
+  std::set<int32_t> stored;
+  for (const StoredKeyframe& keyframe : keyframes) {
+    stored.insert(static_cast<int32_t>(keyframe.index));
+    EXPECT_TRUE(same_keyframe(keyframe, make_keyframe(0, keyframe.index, 500)))
+        << "keyframe " << keyframe.index;
+  }
+  for (const int32_t i : reported)
+    EXPECT_EQ(stored.count(i), 1u) << "flushed keyframe " << i << " lost";
+  EXPECT_LE(keyframes.size(), reported.size() + 1);
 }
 
 TEST(CrashKill, EveryReportedChunkSurvivesSigkill) {

@@ -10,7 +10,10 @@
 
 namespace featsense::storage {
 
-constexpr int32_t kFormatVersion = 1;
+/// The version this program writes. Version 2 added the sessions and keyframes; version 1
+/// files are still read (as having none). FORMAT.md, "Compatibility", says why it changed.
+constexpr int32_t kFormatVersion = 2;
+constexpr int32_t kOldestReadFormatVersion = 1;
 
 /// Written when a map is created, checked when it is opened.
 struct MapMetadata {

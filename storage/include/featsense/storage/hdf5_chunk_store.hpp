@@ -1,7 +1,8 @@
 #pragma once
 /// The global map in an HDF5 file (layout in storage/FORMAT.md) with a journal beside it
 /// (`<path>.journal`) that makes every flush durable: after a crash at any moment the map
-/// opens with every chunk flushed before it. Recently used chunks stay in an LRU cache.
+/// opens with every chunk flushed before it. Recently used chunks stay in an LRU cache. The
+/// file also keeps the trajectory, the sessions that made the map and their keyframes.
 
 #include <cstddef>
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "featsense/storage/chunk_store.hpp"
+#include "featsense/storage/map_sessions.hpp"
 
 namespace featsense::storage {
 
@@ -69,6 +71,22 @@ class Hdf5ChunkStore final : public ChunkStore {
   void write_trajectory(const std::vector<TrajectoryPose>& poses);
   std::vector<TrajectoryPose> read_trajectory() const { return trajectory_; }
 
+  /// Adds keyframes, or replaces those of the same (session, index); durable at the next
+  /// flush, like chunks. Every keyframe is checked first (descriptor of rows x cols values,
+  /// whole points, finite stamp and pose): std::invalid_argument, and none is stored.
+  void write_keyframes(const std::vector<StoredKeyframe>& keyframes);
+  /// Every stored keyframe, sorted by (session, index); read from the file on each call.
+  std::vector<StoredKeyframe> read_keyframes() const;
+  /// One keyframe, or nothing when none has this key: for reading a large map's keyframes
+  /// one at a time rather than all at once.
+  std::optional<StoredKeyframe> read_keyframe(const KeyframeKey& key) const;
+  /// The keys of every stored keyframe, sorted, without reading the keyframes.
+  std::vector<KeyframeKey> keyframe_keys() const;
+  /// Replaces the sessions table (durable at the next flush). Ids must be unique and stamps
+  /// finite, else std::invalid_argument.
+  void write_sessions(const std::vector<MapSession>& sessions);
+  std::vector<MapSession> read_sessions() const { return sessions_; }
+
   /// Flushes, then writes a new .h5 holding everything, replaces the old one atomically and
   /// empties the journal.
   void checkpoint();
@@ -98,6 +116,10 @@ class Hdf5ChunkStore final : public ChunkStore {
   /// the work, runs in parallel, a batch of chunks at a time.
   void journal_chunks(const std::vector<ChunkKey>& keys);
   Chunk load(const ChunkKey& key, const Location& where) const;
+  StoredKeyframe load_keyframe(const KeyframeKey& key, const Location& where) const;
+  /// Appends the unflushed keyframes and, when changed, the sessions table to the journal.
+  void journal_keyframes_and_sessions();
+  bool has_unflushed_writes() const;
 
   std::filesystem::path path_;
   StoreSettings settings_;
@@ -112,6 +134,10 @@ class Hdf5ChunkStore final : public ChunkStore {
   std::list<ChunkKey> lru_;  ///< front = most recently used
   std::vector<TrajectoryPose> trajectory_;
   bool trajectory_dirty_ = false;
+  std::map<KeyframeKey, Location> keyframes_;  ///< durable keyframes (journal wins over .h5)
+  std::map<KeyframeKey, StoredKeyframe> unflushed_keyframes_;
+  std::vector<MapSession> sessions_;
+  bool sessions_dirty_ = false;
 };
 
 }  // namespace featsense::storage
