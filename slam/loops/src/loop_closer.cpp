@@ -392,4 +392,14 @@ TrajectoryCorrection LoopCloser::correction() const {
   return out;
 }
 
+std::vector<KeyframeRecord> LoopCloser::keyframe_records() const {
+  std::vector<KeyframeRecord> records;
+  records.reserve(keyframes_.size());
+  for (size_t i = 0; i < keyframes_.size(); ++i) {
+    const Keyframe& keyframe = keyframes_[i];
+    records.push_back({keyframe.stamp_ns, graph_.pose(i), keyframe.descriptor, keyframe.cloud});
+  }
+  return records;
+}
+
 }  // namespace featsense::slam::loops

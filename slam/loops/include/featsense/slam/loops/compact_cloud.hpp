@@ -22,6 +22,8 @@ class CompactCloud {
   std::vector<Eigen::Vector3f> points() const;
   size_t size() const { return coordinates_.size() / 3; }
   size_t bytes() const { return coordinates_.size() * sizeof(int16_t); }
+  /// x y z of each point in units of kResolutionM, as a map file keeps them.
+  const std::vector<int16_t>& coordinates() const { return coordinates_; }
 
  private:
   std::vector<int16_t> coordinates_;  ///< x y z of each point

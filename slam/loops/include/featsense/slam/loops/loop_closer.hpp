@@ -136,6 +136,15 @@ struct LoopCounts {
   size_t cloud_bytes = 0;  ///< the keyframes' compact clouds
 };
 
+/// A keyframe as a map keeps it for later sessions: where the graph puts it now, its place
+/// descriptor and its points.
+struct KeyframeRecord {
+  int64_t stamp_ns = 0;
+  Eigen::Isometry3d T_map_sensor = Eigen::Isometry3d::Identity();
+  ScanContext descriptor;
+  CompactCloud cloud;
+};
+
 class LoopCloser {
  public:
   explicit LoopCloser(const LoopSettings& settings);
@@ -167,6 +176,8 @@ class LoopCloser {
   TrajectoryCorrection correction() const;
 
   size_t keyframes() const { return keyframes_.size(); }
+  /// Every keyframe in order, at the graph's current pose.
+  std::vector<KeyframeRecord> keyframe_records() const;
   const std::vector<LoopRecord>& loops() const { return loops_; }
   const LoopCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
