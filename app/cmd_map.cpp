@@ -218,9 +218,17 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   if (odometry && !no_loops.empty()) spdlog::info("loop closure off: {}", no_loops);
   if (!info.imu.empty()) spdlog::info("IMU: {}", info.imu);
 
-  MapPassOutput pass =
-      run_map_pass(source, *locator, pipeline, config,
-                   {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite});
+  // The run as the map's session: with given poses they place it; the odometry's map frame
+  // is the first scan's, or the true first pose's where the truth is known.
+  SessionDescription session{info.path, info.format, "given poses"};
+  if (odometry) {
+    session.placement = truth && truth->starts_at_first_scan && !truth->poses.empty()
+                            ? "odometry from the true first pose"
+                            : "odometry, the map frame at the first scan";
+  }
+  MapPassOutput pass = run_map_pass(
+      source, *locator, pipeline, config,
+      {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite, session});
   const PipelineResult first = pass.result;  // the odometry's poses, before the loops
   const std::optional<LoopOutcome>& loops = first.loops;
   std::string second_pass = "no loop closed, no gravity";
@@ -261,8 +269,11 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
         PipelineSettings replay = pipeline;
         replay.refine.reset();
         replay.loops.reset();
+        SessionDescription corrected_session = session;
+        corrected_session.placement += ", loops closed";
         replayed = run_map_pass(*again, *corrected, replay, config,
-                                {replay_path, info.sensor.name, std::nullopt, true});
+                                {replay_path, info.sensor.name, std::nullopt, true,
+                                 corrected_session, &loops->keyframes});
       } catch (const std::exception& e) {
         // The input changed or went away since the first pass: its map stays.
         spdlog::warn("the second pass failed: {}; the map keeps the odometry's poses", e.what());

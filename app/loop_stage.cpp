@@ -75,6 +75,7 @@ LoopOutcome LoopStage::finish() {
   out.gravity = out.final_optimisation.gravity;
   out.loops = closer_.loops();
   out.counts = closer_.counts();
+  out.keyframes = closer_.keyframe_records();
   out.keyframe_queue_wait_ms = wait_ms_;
   out.before = path_;
   out.corrected = corrected_path(closer_.correction(), path_, travelled_m_);

@@ -29,6 +29,8 @@ struct LoopOutcome {
   double keyframe_queue_wait_ms = 0.0;  ///< the pipeline's wait for the loop thread, in all
   /// Where the input had an IMU: gravity levelled the graph (observations > 0).
   slam::loops::GravityEstimate gravity;
+  /// The keyframes at their final poses, for the map file (later sessions relocalize in them).
+  std::vector<slam::loops::KeyframeRecord> keyframes;
   /// Whether the corrected poses differ from those the map was made with: loops were closed
   /// or gravity levelled the path.
   bool corrects_poses() const { return !loops.empty() || gravity.observations > 0; }

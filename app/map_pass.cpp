@@ -68,6 +68,11 @@ MapPassOutput run_map_pass(slam::ScanSource& source, slam::ScanLocator& locator,
   for (size_t i = 0; i < out.result.poses.size(); ++i)
     all_poses.push_back(out.result.poses.stamps_ns[i], out.result.poses.poses[i]);
   store.write_trajectory(to_store_poses(all_poses));
+  const std::vector<slam::loops::KeyframeRecord> no_keyframes;
+  const std::vector<slam::loops::KeyframeRecord>& keyframes =
+      request.keyframes ? *request.keyframes
+                        : (out.result.loops ? out.result.loops->keyframes : no_keyframes);
+  record_session(store, request.session, out.result.poses, keyframes);
   out.map_chunks = store.keys().size();
   store.close();
   if (integrator) {

@@ -15,6 +15,7 @@
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/storage/shifting_map.hpp"
 #include "map_pipeline.hpp"
+#include "map_sessions.hpp"
 
 namespace featsense::app {
 
@@ -24,6 +25,10 @@ struct MapStoreRequest {
   std::string sensor_name;
   std::optional<std::string> continue_from;
   bool overwrite = false;
+  /// The run as the map's new session (map_sessions.hpp).
+  SessionDescription session;
+  /// The keyframes the session keeps; null: those of this pass's loop closure, where it ran.
+  const std::vector<slam::loops::KeyframeRecord>* keyframes = nullptr;
 };
 
 struct MapPassOutput {

@@ -7,6 +7,7 @@
 
 #include "featsense/config/config_error.hpp"
 #include "featsense/storage/vdb_io.hpp"
+#include "map_sessions.hpp"
 
 namespace featsense::app {
 namespace {
@@ -146,6 +147,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   result.store =
       std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
   result.continued_chunks = copy_chunks(old_map, *result.store);
+  copy_sessions(old_map, *result.store);
   return result;
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -110,6 +111,17 @@ TEST_F(CliMap, ContinuingAMapGivesTheMapOfOneRun) {
   EXPECT_EQ(count_lines(dir / "second" / "trajectory.tum"), 12u);
   storage::Hdf5ChunkStore continued(dir / "second" / "map.h5");
   EXPECT_EQ(continued.read_trajectory().size(), 24u) << "the old poses and the new";
+  // Each run is a session of the map: the first one's kept, the second's added after it.
+  const std::vector<storage::MapSession> sessions = continued.read_sessions();
+  ASSERT_EQ(sessions.size(), 2u);
+  for (uint32_t id = 0; id < 2; ++id) {
+    EXPECT_EQ(sessions[id].id, id);
+    EXPECT_EQ(sessions[id].scans, 12u);
+    EXPECT_EQ(sessions[id].placement, "given poses");
+    EXPECT_EQ(sessions[id].input, sequence());
+  }
+  EXPECT_LT(sessions[0].last_stamp_s, sessions[1].first_stamp_s);
+  continued.close();
   expect_same_maps(dir / "whole" / "map.h5", dir / "second" / "map.h5");
 }
 
@@ -256,7 +268,34 @@ TEST_F(CliMap, ClosedLoopsMapTheRecordingAgainWithTheCorrectedPoses) {
   EXPECT_TRUE(fs::exists(dir / "out" / "map.h5"));
   EXPECT_FALSE(fs::exists(dir / "out" / "map.corrected.h5"));
   EXPECT_EQ(count_lines(dir / "out" / "trajectory.tum"), 24u);
-  EXPECT_EQ(storage::Hdf5ChunkStore(dir / "out" / "map.h5").read_trajectory().size(), 24u);
+  {
+    // The map keeps the run as its session, and its keyframes at their corrected poses, for
+    // a later recording to be placed by.
+    storage::Hdf5ChunkStore stored(dir / "out" / "map.h5");
+    const std::vector<storage::TrajectoryPose> poses = stored.read_trajectory();
+    EXPECT_EQ(poses.size(), 24u);
+    const std::vector<storage::MapSession> sessions = stored.read_sessions();
+    ASSERT_EQ(sessions.size(), 1u);
+    EXPECT_EQ(sessions[0].scans, 24u);
+    EXPECT_EQ(sessions[0].placement, "odometry from the true first pose, loops closed");
+    const std::vector<storage::StoredKeyframe> keyframes = stored.read_keyframes();
+    EXPECT_EQ(keyframes.size(), closed["keyframes"].get<size_t>());
+    for (const storage::StoredKeyframe& keyframe : keyframes) {
+      EXPECT_EQ(keyframe.session, 0u);
+      EXPECT_EQ(keyframe.descriptor.size(),
+                static_cast<size_t>(keyframe.descriptor_rows) * keyframe.descriptor_cols);
+      EXPECT_GT(keyframe.descriptor_rows, 0u);
+      EXPECT_GT(keyframe.points(), 100u);
+      const auto at = std::find_if(poses.begin(), poses.end(), [&](const auto& p) {
+        return std::abs(p.t_s - keyframe.pose.t_s) < 1e-6;
+      });
+      ASSERT_NE(at, poses.end()) << keyframe.pose.t_s;
+      // The corrected trajectory passes through the keyframes' poses.
+      EXPECT_NEAR(at->x, keyframe.pose.x, 1e-3);
+      EXPECT_NEAR(at->y, keyframe.pose.y, 1e-3);
+      EXPECT_NEAR(at->z, keyframe.pose.z, 1e-3);
+    }
+  }
   ASSERT_TRUE(report["eval"].contains("traj_before_loops")) << report["eval"].dump(2);
   EXPECT_LT(report["eval"]["traj"]["ape"]["rmse"].get<double>(), 0.05);
 
