@@ -1,5 +1,5 @@
 #pragma once
-// Small Ouster metadata documents for the tests, in both JSON layouts of FORMATS.md.
+// Small Ouster metadata documents for the tests, in both JSON layouts of PACKET_FORMAT.md.
 
 #include <nlohmann/json.hpp>
 

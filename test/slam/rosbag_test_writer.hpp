@@ -1,7 +1,7 @@
 #pragma once
 // A small ROS1 bag writer (format 2.0) for tests: chunks of each compression, the index at
 // the end or none (as a recording cut off before closing), and serializers for the
-// messages the reader decodes. Written from the format description (FORMATS.md), so that
+// messages the reader decodes. Written from the ROS bag 2.0 format description, so that
 // tests compare what the reader returns with what was written.
 
 #include <bzlib.h>

@@ -132,7 +132,7 @@ TEST(BagRecordReader, RealOusterBagCatalog) {
   EXPECT_EQ(classify_topic(*metadata), BagTopicKind::kOusterMetadata);
   EXPECT_EQ(metadata_topic_for(catalog, *lidar), metadata);
   EXPECT_EQ(&choose_scan_topic(catalog, std::nullopt, "bag"), lidar);
-  // FORMATS.md: one uncompressed chunk; the bag was closed, so the index sufficed.
+  // The bag format: one uncompressed chunk; the bag was closed, so the index sufficed.
   EXPECT_TRUE(catalog.from_index);
   EXPECT_EQ(catalog.chunks, 1u);
   EXPECT_EQ(catalog.compressions, std::vector<std::string>{"none"});
@@ -161,7 +161,7 @@ TEST(BagRecordReader, RealOusterBagCatalog) {
   EXPECT_EQ(imu->messages, 10u);
 
   // Streaming every message: the lidar payloads have the packet size of the metadata's
-  // profile (RNG15_RFL8_NIR8: 4-byte pixels; FORMATS.md), the IMU ones 48 bytes.
+  // profile (RNG15_RFL8_NIR8: 4-byte pixels; PACKET_FORMAT.md), the IMU ones 48 bytes.
   const std::string bag = read_file(path);
   const ReadBack read = read_all(bag);
   EXPECT_TRUE(read.warnings.empty());

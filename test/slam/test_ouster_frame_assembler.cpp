@@ -1,5 +1,5 @@
 // Ouster packet decoding and frame assembly on packets built here byte by byte from the
-// layouts of FORMATS.md, with known ranges and angles, checked against closed-form geometry.
+// layouts of PACKET_FORMAT.md, with known ranges and angles, checked against closed-form geometry.
 
 #include <gtest/gtest.h>
 
@@ -54,7 +54,7 @@ PacketSpec make_spec(const std::string& profile, int frame, int first_column, in
   return spec;
 }
 
-/// One packet of FORMATS.md's layouts.
+/// One packet of PACKET_FORMAT.md's layouts.
 std::vector<uint8_t> build_packet(const PacketSpec& spec) {
   const bool legacy = spec.profile == "LEGACY";
   const bool rng15 = spec.profile == "RNG15_RFL8_NIR8";
@@ -195,7 +195,7 @@ TEST(OusterFrameAssembler, DecodesRng15Packets) {
 }
 
 TEST(OusterFrameAssembler, RangeBitsAboveTheFieldAreIgnored) {
-  // RNG19: 19 bits of range (FORMATS.md); legacy 20. Bits above belong to other fields.
+  // RNG19: 19 bits of range (PACKET_FORMAT.md); legacy 20. Bits above belong to other fields.
   for (const auto& [profile, bits] : {std::make_pair(std::string("RNG19_RFL8_SIG16_NIR16"), 19),
                                       std::make_pair(std::string("LEGACY"), 20)}) {
     OusterFrameAssembler assembler(metadata(plain_metadata(profile)));
@@ -209,7 +209,7 @@ TEST(OusterFrameAssembler, RangeBitsAboveTheFieldAreIgnored) {
 
 TEST(OusterFrameAssembler, OffsetsAndSensorTransform) {
   // The tiny metadata has beam azimuths of +-2 deg, a 15.806 mm beam origin offset and the
-  // OS1's lidar_to_sensor_transform. Undo them as FORMATS.md describes and the beam's own
+  // OS1's lidar_to_sensor_transform. Undo them as PACKET_FORMAT.md describes and the beam's own
   // angles and the reported range must come back.
   const json doc = test::tiny_flat_metadata("RNG19_RFL8_SIG16_NIR16");
   OusterFrameAssembler assembler(metadata(doc));
@@ -320,7 +320,7 @@ TEST(OusterFrameAssembler, RejectsWrongSizesAndIgnoresForeignColumns) {
 }
 
 TEST(OusterFrameAssembler, ColumnWindowDefinesACompleteFrame) {
-  // Only columns 8..39 lit (FORMATS.md: column_window): a frame of those is complete.
+  // Only columns 8..39 lit (PACKET_FORMAT.md: column_window): a frame of those is complete.
   json doc = plain_metadata("RNG19_RFL8_SIG16_NIR16");
   doc["data_format"]["column_window"] = {8, 39};
   OusterFrameAssembler assembler(metadata(doc));

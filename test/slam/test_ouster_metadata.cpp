@@ -68,12 +68,12 @@ TEST(OusterMetadata, ReadsTheOs1SensorFile) {
   EXPECT_EQ(meta.pixel_shift_by_row,
             doc["data_format"]["pixel_shift_by_row"].get<std::vector<int>>());
   EXPECT_EQ(meta.lidar_origin_to_beam_origin_mm, 15.806);
-  // FORMATS.md: on the OS1 the transform flips x and y and lifts z by 36.18 mm.
+  // PACKET_FORMAT.md: on the OS1 the transform flips x and y and lifts z by 36.18 mm.
   EXPECT_EQ(meta.lidar_to_sensor[0], -1.0);
   EXPECT_EQ(meta.lidar_to_sensor[5], -1.0);
   EXPECT_EQ(meta.lidar_to_sensor[10], 1.0);
   EXPECT_EQ(meta.lidar_to_sensor[11], 36.18);
-  // FORMATS.md: 32 + 16 x (12 + 128 x 4) + 32 bytes, as the pcap's packets are.
+  // PACKET_FORMAT.md: 32 + 16 x (12 + 128 x 4) + 32 bytes, as the pcap's packets are.
   EXPECT_EQ(meta.packet_size(), 8448u);
 }
 
@@ -122,12 +122,12 @@ TEST(OusterMetadata, NestedLayoutOfTheRealSensorFile) {
 }
 
 TEST(OusterMetadata, ProfilesAndPacketSizes) {
-  // FORMATS.md: legacy = 16 x (16 + 12 H + 4); new profiles = 32 + C x (12 + P H) + 32.
+  // PACKET_FORMAT.md: legacy = 16 x (16 + 12 H + 4); new profiles = 32 + C x (12 + P H) + 32.
   EXPECT_EQ(parse(test::tiny_flat_metadata("")).profile, OusterProfile::kLegacy);
   EXPECT_EQ(parse(test::tiny_flat_metadata("")).packet_size(), 16u * (16 + 16 * 12 + 4));
   EXPECT_EQ(parse(test::tiny_flat_metadata("LEGACY", 64, 1024)).packet_size(), 12608u);
   EXPECT_EQ(parse(test::tiny_flat_metadata("RNG19_RFL8_SIG16_NIR16", 128, 1024)).packet_size(),
-            24832u);  // the OS2-128 size FORMATS.md quotes
+            24832u);  // the OS2-128 size PACKET_FORMAT.md quotes
   EXPECT_EQ(parse(test::tiny_flat_metadata("RNG15_RFL8_NIR8", 16, 64, 8)).packet_size(),
             32u + 8 * (12 + 16 * 4) + 32);
   EXPECT_EQ(to_string(OusterProfile::kRng19Rfl8Sig16Nir16), "RNG19_RFL8_SIG16_NIR16");

@@ -113,7 +113,7 @@ TEST(OusterPcap, Os1GivesThreeFullFrames) {
 
 TEST(OusterPcap, Os1PacketsCarryIncreasingFrameIds) {
   FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
-  // The frame id is bytes 2..3 of the 32-byte packet header (FORMATS.md); data/README.md says
+  // The frame id is bytes 2..3 of the 32-byte packet header (PACKET_FORMAT.md); data/README.md says
   // the capture holds frames 1795 to 1797.
   std::vector<int> ids;
   for (const test::CapturedFrame& frame : test::read_pcap_frames(test::read_file(pcap))) {

@@ -70,7 +70,7 @@ std::string packets_only_bag(const std::filesystem::path& dir, const BagContents
   return test::write_bag_file(dir, "packets_only.bag", writer.finish());
 }
 
-/// Checks a decoded frame against the raw packets, decoded here by the FORMATS.md rules for
+/// Checks a decoded frame against the raw packets, decoded here by the PACKET_FORMAT.md rules for
 /// the RNG15_RFL8_NIR8 profile: u16 range (low 15 bits, 8 mm units), u8 reflectivity, u8
 /// NIR per pixel, the pixel of row i and measurement id m in image column
 /// (m + pixel_shift_by_row[i]) mod W.

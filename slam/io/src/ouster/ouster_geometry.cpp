@@ -30,7 +30,7 @@ OusterPixelGeometry::OusterPixelGeometry(const OusterMetadata& metadata)
 
   const Eigen::Isometry3d lidar_to_sensor = to_isometry(metadata.lidar_to_sensor);
   const double n = metadata.lidar_origin_to_beam_origin_mm * kMmToM;
-  // Only the z offset of beam_to_lidar_transform enters FORMATS.md's formula; its x
+  // Only the z offset of beam_to_lidar_transform enters PACKET_FORMAT.md's formula; its x
   // translation is n again.
   const double beam_z = metadata.beam_to_lidar[11] * kMmToM;
   const double w = static_cast<double>(columns_);

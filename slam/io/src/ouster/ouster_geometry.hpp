@@ -12,7 +12,7 @@ namespace featsense::slam::detail {
 
 /// For the pixel of beam `row` measured at measurement id `m`, the point of range r (metres,
 /// as reported) is `r * direction(row, m) + offset(row, m)` in the sensor frame (metres).
-/// This is FORMATS.md's formula regrouped: the beam origin offset, the beam-to-lidar z offset
+/// This is PACKET_FORMAT.md's formula regrouped: the beam origin offset, the beam-to-lidar z offset
 /// and the lidar-to-sensor transform do not depend on r.
 class OusterPixelGeometry {
  public:

@@ -1,6 +1,6 @@
 // Ouster sensor metadata JSON: the older flat layout (firmware 2.x "legacy" JSON) and the
 // newer nested one (beam_intrinsics, lidar_intrinsics, lidar_data_format, config_params,
-// sensor_info). FORMATS.md lists the keys.
+// sensor_info). PACKET_FORMAT.md lists the keys.
 
 #include <nlohmann/json.hpp>
 
@@ -270,7 +270,7 @@ config::SensorModel OusterMetadata::sensor_model() const {
   model.rate_hz = rate_hz;
   for (double altitude : beam_altitude_deg) model.elevation_rad.push_back(altitude * kDegToRad);
   // SensorModel angles grow counter-clockwise (mathematical sense, as the column azimuth
-  // does); Ouster's beam_azimuth_angles grow clockwise, hence the minus (FORMATS.md:
+  // does); Ouster's beam_azimuth_angles grow clockwise, hence the minus (PACKET_FORMAT.md:
   // theta_a = -2 pi azimuth / 360).
   for (double azimuth : beam_azimuth_deg) model.azimuth_offset_rad.push_back(-azimuth * kDegToRad);
   model.beam_origin_offset_m = lidar_origin_to_beam_origin_mm / 1000.0;
@@ -364,7 +364,7 @@ OusterMetadata parse_ouster_metadata(const std::string& json_text, const std::st
                                         std::to_string(meta.columns_per_frame));
   }
   if (meta.beam_to_lidar == std::array<double, 16>{}) {
-    // Absent: the beam origin lies n mm out along x, in the lidar's plane (FORMATS.md).
+    // Absent: the beam origin lies n mm out along x, in the lidar's plane (PACKET_FORMAT.md).
     meta.beam_to_lidar = {1, 0, 0, meta.lidar_origin_to_beam_origin_mm, 0, 1, 0, 0, 0, 0, 1, 0, 0,
                           0, 0, 1};
   }

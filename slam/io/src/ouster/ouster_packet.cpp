@@ -5,7 +5,7 @@
 namespace featsense::slam::detail {
 namespace {
 
-// Layout constants of FORMATS.md.
+// Layout constants of PACKET_FORMAT.md.
 constexpr size_t kLegacyColumnsPerPacket = 16;
 constexpr size_t kLegacyColumnHeaderBytes = 16;  // u64 timestamp, u16 id, u16 frame, u32 encoder
 constexpr size_t kLegacyStatusBytes = 4;         // u32 status after the pixels
@@ -92,7 +92,7 @@ OusterColumnHeader OusterPacketView::column(int column) const {
 
 namespace {
 
-/// Pixel decoders of FORMATS.md, one per profile; `p` points at the pixel's first byte.
+/// Pixel decoders of PACKET_FORMAT.md, one per profile; `p` points at the pixel's first byte.
 OusterPixel legacy_pixel(const uint8_t* p) {
   OusterPixel out;
   out.range_mm = load_le<uint32_t>(p) & kLegacyRangeMask;

@@ -1,6 +1,6 @@
 #pragma once
 // The byte layout of one Ouster lidar packet (a UDP payload) per profile, and bounds-checked
-// access to its columns and pixels (FORMATS.md).
+// access to its columns and pixels (PACKET_FORMAT.md).
 
 #include <cstddef>
 #include <cstdint>

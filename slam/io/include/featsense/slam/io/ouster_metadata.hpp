@@ -1,6 +1,6 @@
 #pragma once
 /// The sensor metadata JSON that Ouster sensors publish (both the older flat layout and the
-/// newer nested one; FORMATS.md lists the keys).
+/// newer nested one; slam/io/src/ouster/PACKET_FORMAT.md lists the keys).
 
 #include <array>
 #include <string>
