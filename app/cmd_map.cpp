@@ -28,6 +28,7 @@
 #include "map_pass.hpp"
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
+#include "map_sessions.hpp"
 #include "report_html.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
@@ -324,6 +325,10 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     }
   }
   if (pipeline.refine) report["refine"] = refine_json(first, *pipeline.refine);
+  // Every run that made the map, this one last.
+  if (pipeline.integrate && fs::exists(out / "map.h5")) {
+    report["sessions"] = sessions_json(out / "map.h5");
+  }
   if (loops) {
     report["loops"] = loops_json(*loops, first.timings.loops_finish_ms);
     report["loops"]["second_pass"] = second_pass;

@@ -4,7 +4,10 @@
 // the map frame, so that a later recording can be placed in the map by them
 // (storage/FORMAT.md, /sessions and /keyframes).
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -26,6 +29,10 @@ struct SessionDescription {
 uint32_t record_session(storage::Hdf5ChunkStore& store, const SessionDescription& session,
                         const slam::Trajectory& poses,
                         const std::vector<slam::loops::KeyframeRecord>& keyframes);
+
+/// The sessions of the map at `path` for the report: each with its input, format, scans,
+/// stamps, placement and the number of keyframes it keeps.
+nlohmann::json sessions_json(const std::filesystem::path& path);
 
 /// The sessions and keyframes of `from` into `to`, one keyframe at a time (a map continued
 /// into another file keeps them).

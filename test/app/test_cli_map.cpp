@@ -122,6 +122,12 @@ TEST_F(CliMap, ContinuingAMapGivesTheMapOfOneRun) {
   }
   EXPECT_LT(sessions[0].last_stamp_s, sessions[1].first_stamp_s);
   continued.close();
+  // The report lists them, this run last.
+  const nlohmann::json reported = read_json(dir / "second" / "report.json")["sessions"];
+  ASSERT_EQ(reported.size(), 2u) << reported.dump(2);
+  EXPECT_EQ(reported[1]["id"], 1);
+  EXPECT_EQ(reported[1]["scans"], 12);
+  EXPECT_EQ(reported[1]["keyframes"], 0) << "no loop closure with given poses";
   expect_same_maps(dir / "whole" / "map.h5", dir / "second" / "map.h5");
 }
 
@@ -278,6 +284,7 @@ TEST_F(CliMap, ClosedLoopsMapTheRecordingAgainWithTheCorrectedPoses) {
     ASSERT_EQ(sessions.size(), 1u);
     EXPECT_EQ(sessions[0].scans, 24u);
     EXPECT_EQ(sessions[0].placement, "odometry from the true first pose, loops closed");
+    EXPECT_EQ(report["sessions"][0]["keyframes"], closed["keyframes"]);
     const std::vector<storage::StoredKeyframe> keyframes = stored.read_keyframes();
     EXPECT_EQ(keyframes.size(), closed["keyframes"].get<size_t>());
     for (const storage::StoredKeyframe& keyframe : keyframes) {
