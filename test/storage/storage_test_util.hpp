@@ -1,13 +1,16 @@
 #pragma once
-// Chunks with known contents for the store tests, and the metadata they use.
+// Chunks, keyframes and sessions with known contents for the store tests, the metadata they
+// use, and the journal beside a map.
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <random>
 #include <string>
 
 #include "featsense/storage/chunk.hpp"
 #include "featsense/storage/chunk_store.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/storage/map_sessions.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
@@ -98,6 +101,18 @@ inline storage::MapMetadata test_metadata() {
   m.sensor = "ouster-os1-64";
   m.config_yaml = "map:\n  voxel_size_m: 0.064\n  truncation_m: 0.6\n";
   return m;
+}
+
+/// The journal written beside `map` (storage/FORMAT.md).
+inline std::filesystem::path journal_of(const std::filesystem::path& map) {
+  return std::filesystem::path(map.string() + ".journal");
+}
+
+/// A store that leaves its journal as it is when closed: what a kill leaves behind.
+inline storage::StoreSettings no_checkpoint() {
+  storage::StoreSettings settings;
+  settings.checkpoint_on_close = false;
+  return settings;
 }
 
 }  // namespace featsense::test

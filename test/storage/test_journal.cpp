@@ -15,18 +15,10 @@
 namespace featsense::storage {
 namespace {
 
+using test::journal_of;
 using test::make_chunk;
+using test::no_checkpoint;
 using test::test_metadata;
-
-std::filesystem::path journal_of(const std::filesystem::path& map) {
-  return std::filesystem::path(map.string() + ".journal");
-}
-
-StoreSettings no_checkpoint() {
-  StoreSettings settings;
-  settings.checkpoint_on_close = false;
-  return settings;
-}
 
 TEST(Journal, FlushedChunksSurviveWithoutCheckpoint) {
   const auto path = test::scratch_dir("journal_replay") / "map.h5";

@@ -19,22 +19,14 @@
 namespace featsense::storage {
 namespace {
 
+using test::journal_of;
 using test::make_chunk;
 using test::make_keyframe;
 using test::make_session;
+using test::no_checkpoint;
 using test::same_keyframe;
 using test::same_session;
 using test::test_metadata;
-
-std::filesystem::path journal_of(const std::filesystem::path& map) {
-  return std::filesystem::path(map.string() + ".journal");
-}
-
-StoreSettings no_checkpoint() {
-  StoreSettings settings;
-  settings.checkpoint_on_close = false;
-  return settings;
-}
 
 std::vector<StoredKeyframe> keyframes_of(uint32_t session, uint32_t first, uint32_t count) {
   std::vector<StoredKeyframe> keyframes;
