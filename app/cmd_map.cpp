@@ -23,6 +23,7 @@
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "front_end_report.hpp"
 #include "json_output.hpp"
+#include "map_continue.hpp"
 #include "map_job.hpp"
 #include "map_outputs.hpp"
 #include "map_pass.hpp"
@@ -143,11 +144,9 @@ PlanInputs plan_inputs(const MapOptions& options, const slam::Trajectory& final_
 }
 
 /// Why the loop closure does not run (empty: it does).
-std::string loop_closure_off_because(bool odometry, const MapOptions& options,
-                                     const config::Config& config) {
+std::string loop_closure_off_because(bool odometry, const config::Config& config) {
   if (!odometry) return "the poses are given";
   if (!config.loop.enabled) return "loop.enabled is false";
-  if (options.continue_from) return "--continue keeps the stored map's poses";
   return "";
 }
 
@@ -193,7 +192,9 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   if (poses) {
     given = slam::make_given_pose_locator(std::move(*poses), config.odometry.deskew);
   } else {
-    const bool anchored = truth && truth->starts_at_first_scan && !truth->poses.empty();
+    // A recording continuing a map starts in its own frame until it is placed in the map.
+    const bool anchored =
+        truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from;
     odometry = slam::odometry::make_odometry_locator(
         config, anchored ? truth->poses.poses.front() : Eigen::Isometry3d::Identity());
   }
@@ -209,7 +210,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
   pipeline.integrate = !options.poses_only;
   if (odometry && config.refine.enabled) pipeline.refine = slam::refine::from_config(config);
-  const std::string no_loops = loop_closure_off_because(odometry != nullptr, options, config);
+  const std::string no_loops = loop_closure_off_because(odometry != nullptr, config);
   if (no_loops.empty()) pipeline.loops = slam::loops::from_config(config);
   spdlog::info("mapping {} ({}; per-point times {}) with {}{}{}", info.path, info.format,
                info.times.empty() ? std::string("unknown") : info.times, locator->description(),
@@ -223,22 +224,49 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   // is the first scan's, or the true first pose's where the truth is known.
   SessionDescription session{info.path, info.format, "given poses"};
   if (odometry) {
-    session.placement = truth && truth->starts_at_first_scan && !truth->poses.empty()
-                            ? "odometry from the true first pose"
-                            : "odometry, the map frame at the first scan";
+    session.placement =
+        truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from
+            ? "odometry from the true first pose"
+            : "odometry, the map frame at the first scan";
   }
-  MapPassOutput pass = run_map_pass(
-      source, *locator, pipeline, config,
-      {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite, session});
-  const PipelineResult first = pass.result;  // the odometry's poses, before the loops
-  const std::optional<LoopOutcome>& loops = first.loops;
+  MapPassOutput pass;
+  PipelineResult first;  // the odometry's poses, before the loops
   std::string second_pass = "no loop closed, no gravity";
   std::optional<PipelineResult> second;
+  std::optional<ContinuedRun> continued;
+  if (odometry && options.continue_from) {
+    // A bare recording into a saved map: placed by its keyframes first (map_continue.hpp).
+    ContinueRequest request{*options.continue_from, out,     info.sensor.name,
+                            options.overwrite,      session, std::nullopt};
+    if (options.initial_pose) request.guess = parse_initial_pose(*options.initial_pose);
+    try {
+      continued = map_into_saved_map(source, *odometry, pipeline, config, request, reopen);
+    } catch (const RelocalizationFailed& e) {
+      write_json({{"input", info.path},
+                  {"format", info.format},
+                  {"status", "refused: not placed in the saved map"},
+                  {"relocalization", e.report()}},
+                 (out / "report.json").string());
+      throw;
+    }
+    pass = std::move(continued->pass);
+    first = std::move(continued->first);
+    second = pass.result;
+    second_pass = continued->second_pass;
+  } else {
+    pass = run_map_pass(
+        source, *locator, pipeline, config,
+        {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite, session});
+    first = pass.result;
+  }
+  const std::optional<LoopOutcome>& loops = first.loops;
   // Levelled by gravity alone, the poses may move less than the map can show: then the first
   // map stays (a second pass would double the run for nothing).
   const double quarter_voxel_m = 0.25 * config.map.voxel_size_m;
   const bool levelled_only = loops && loops->loops.empty() && loops->gravity.observations > 0;
-  if (levelled_only && loops->corrections_max_m < quarter_voxel_m) {
+  if (continued) {
+    // Mapped once, with the poses placed and corrected in the saved map.
+  } else if (levelled_only && loops->corrections_max_m < quarter_voxel_m) {
     char why[160];
     std::snprintf(why, sizeof why,
                   "levelled by gravity, no scan moved more than a quarter voxel (%.1f mm): the "
@@ -298,7 +326,8 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   // The poses the map was made with; with loops closed and no second pass, the corrected ones
   // all the same (to map later with --gt).
   const slam::Trajectory& final_poses =
-      loops && loops->corrects_poses() && !second ? loops->corrected : result.poses;
+      continued ? continued->final_poses
+                : (loops && loops->corrects_poses() && !second ? loops->corrected : result.poses);
   slam::write_tum(final_poses, (out / "trajectory.tum").string());
   slam::write_kitti(final_poses, (out / "trajectory.kitti").string());
 
@@ -329,6 +358,7 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   if (pipeline.integrate && fs::exists(out / "map.h5")) {
     report["sessions"] = sessions_json(out / "map.h5");
   }
+  if (continued) report["relocalization"] = continued->report;
   if (loops) {
     report["loops"] = loops_json(*loops, first.timings.loops_finish_ms);
     report["loops"]["second_pass"] = second_pass;
@@ -418,6 +448,9 @@ Command register_map(CLI::App& app, const CliContext& context) {
   command->add_option("--continue", options->continue_from,
                       "Continue an existing map (.h5 or .vdb): its voxel size and tau are kept "
                       "(map.voxel_size and map.truncation, if set, must be the same)");
+  command->add_option("--initial-pose", options->initial_pose,
+                      "With --continue and no --gt: where the recording's first scan lies in the "
+                      "map, roughly, as x,y,z,yaw_deg (it is still verified)");
   command->add_option("--start", options->start,
                       "First scan to map: a frame index, or seconds after the first scan (12.5s)");
   command->add_option("--end", options->end, "Last scan to map (as --start)");

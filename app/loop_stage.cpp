@@ -23,11 +23,13 @@ slam::Trajectory corrected_path(const slam::loops::TrajectoryCorrection& correct
   return out;
 }
 
-LoopStage::LoopStage(const slam::loops::LoopSettings& settings)
+LoopStage::LoopStage(const slam::loops::LoopSettings& settings,
+                     std::optional<RelocalizeStage> relocalize)
     : settings_(settings),
       selector_(settings.keyframe_distance_m, settings.keyframe_angle_deg),
       closer_(settings),
       queue_(kKeyframesQueued),
+      relocalize_(relocalize),
       worker_([this] { work(); }) {}
 
 LoopStage::~LoopStage() {
@@ -37,8 +39,16 @@ LoopStage::~LoopStage() {
 
 void LoopStage::work() {
   try {
-    while (std::optional<KeyframeJob> job = queue_.pop())
+    while (std::optional<KeyframeJob> job = queue_.pop()) {
       closer_.add_keyframe(job->stamp_ns, job->travelled_m, job->T_map_sensor, job->points);
+      if (!relocalize_ || relocalize_->relocalizer->placement()) continue;
+      if (job->scan >= relocalize_->max_scans) {
+        relocalize_gave_up_.store(true);
+        continue;
+      }
+      relocalize_->relocalizer->add_keyframe(job->stamp_ns, job->T_map_sensor, job->travelled_m,
+                                             job->points);
+    }
   } catch (...) {
     failure_ = std::current_exception();
     queue_.abandon();
@@ -46,6 +56,8 @@ void LoopStage::work() {
 }
 
 bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placement) {
+  if (relocalize_gave_up_.load()) return false;
+  const size_t scan_index = path_.size();
   const bool keyframe = selector_.next(placement.T_map_sensor);
   path_.push_back(placement.stamp_ns, placement.T_map_sensor);
   travelled_m_.push_back(selector_.travelled_m());
@@ -55,6 +67,7 @@ bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placeme
   job.stamp_ns = placement.stamp_ns;
   job.travelled_m = selector_.travelled_m();
   job.T_map_sensor = placement.T_map_sensor;
+  job.scan = scan_index;
   job.points = slam::refine::voxel_centroids(scan, placement, settings_.cloud_voxel_m);
   const auto start = std::chrono::steady_clock::now();
   const bool queued = queue_.push(std::move(job));
@@ -77,6 +90,11 @@ LoopOutcome LoopStage::finish() {
   out.counts = closer_.counts();
   out.keyframes = closer_.keyframe_records();
   out.keyframe_queue_wait_ms = wait_ms_;
+  if (relocalize_) {
+    out.relocalization = relocalize_->relocalizer->placement();
+    out.relocalize_counts = relocalize_->relocalizer->counts();
+    out.relocalize_gave_up = relocalize_gave_up_.load();
+  }
   out.before = path_;
   out.corrected = corrected_path(closer_.correction(), path_, travelled_m_);
   for (size_t i = 0; i < path_.size(); ++i) {

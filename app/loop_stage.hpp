@@ -5,13 +5,16 @@
 // unless it falls a few keyframes behind. At the end, where the input had an IMU, its gravity
 // levels the graph too, and the corrections of the keyframes are spread over every scan's pose.
 
+#include <atomic>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
 
 #include "bounded_queue.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/loops/relocalizer.hpp"
 #include "featsense/slam/scan.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
@@ -31,6 +34,11 @@ struct LoopOutcome {
   slam::loops::GravityEstimate gravity;
   /// The keyframes at their final poses, for the map file (later sessions relocalize in them).
   std::vector<slam::loops::KeyframeRecord> keyframes;
+  /// With a relocalizer: where the run was placed in the saved map (none: not placed), what
+  /// was tried, and whether it gave up after its scans (the run was stopped there).
+  std::optional<slam::loops::Relocalization> relocalization;
+  slam::loops::RelocalizationCounts relocalize_counts;
+  bool relocalize_gave_up = false;
   /// Whether the corrected poses differ from those the map was made with: loops were closed
   /// or gravity levelled the path.
   bool corrects_poses() const { return !loops.empty() || gravity.observations > 0; }
@@ -42,14 +50,23 @@ slam::Trajectory corrected_path(const slam::loops::TrajectoryCorrection& correct
                                 const slam::Trajectory& path,
                                 const std::vector<double>& travelled_m);
 
+/// Relocalization in a saved map, alongside the loop closure: each keyframe of the first
+/// `max_scans` scans goes to the relocalizer until it places the run.
+struct RelocalizeStage {
+  slam::loops::Relocalizer* relocalizer = nullptr;
+  size_t max_scans = 0;
+};
+
 class LoopStage {
  public:
-  explicit LoopStage(const slam::loops::LoopSettings& settings);
+  explicit LoopStage(const slam::loops::LoopSettings& settings,
+                     std::optional<RelocalizeStage> relocalize = std::nullopt);
   ~LoopStage();
   LoopStage(const LoopStage&) = delete;
   LoopStage& operator=(const LoopStage&) = delete;
 
-  /// The next scan whose pose is final, in order. False once the stage was abandoned.
+  /// The next scan whose pose is final, in order. False once the stage was abandoned, or the
+  /// relocalization gave up (the run stops).
   bool offer(const slam::Scan& scan, const slam::ScanPlacement& placement);
   /// No more scans: the loop thread finishes the keyframes queued, the graph is optimised
   /// once more and every pose corrected. Rethrows the loop thread's failure.
@@ -63,6 +80,7 @@ class LoopStage {
     double travelled_m = 0.0;
     Eigen::Isometry3d T_map_sensor;
     std::vector<Eigen::Vector3f> points;
+    size_t scan = 0;  ///< how many scans were offered before it
   };
   void work();
 
@@ -75,6 +93,8 @@ class LoopStage {
   std::vector<double> travelled_m_;
   std::vector<slam::ImuSample> imu_;  ///< every scan's, in order
   double wait_ms_ = 0.0;
+  std::optional<RelocalizeStage> relocalize_;
+  std::atomic<bool> relocalize_gave_up_{false};
   std::thread worker_;  ///< last: it starts once everything it uses is there
 };
 

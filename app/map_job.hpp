@@ -25,6 +25,7 @@ struct MapOptions {
   std::optional<std::string> gt_times;
   std::optional<std::string> backend;
   std::optional<std::string> continue_from;
+  std::optional<std::string> initial_pose;  ///< x,y,z,yaw_deg of the first scan in the map
   std::optional<std::string> start;
   std::optional<std::string> end;
   std::optional<std::string> reference;

@@ -270,7 +270,7 @@ PipelineResult run_map_pipeline(slam::ScanSource& source, slam::ScanLocator& loc
   }
   BoundedQueue<PlacedScan>& to_rays = settings.refine ? refined : placed;
   std::unique_ptr<LoopStage> loops;
-  if (settings.loops) loops = std::make_unique<LoopStage>(*settings.loops);
+  if (settings.loops) loops = std::make_unique<LoopStage>(*settings.loops, settings.relocalize);
   std::thread rays([&] {
     guarded(state, [&] { make_rays(to_rays, located, loops.get(), settings.integrate, result); });
     if (state.stopping()) to_rays.abandon();

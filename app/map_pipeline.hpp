@@ -53,6 +53,9 @@ struct PipelineSettings {
   /// Close loops over the final poses (loop.*; for odometry): keyframes, verification, the
   /// pose graph in a thread of their own; the corrected poses come with the result.
   std::optional<slam::loops::LoopSettings> loops;
+  /// With loops: relocalize the run in a saved map as its keyframes come (`map --continue`
+  /// without poses).
+  std::optional<RelocalizeStage> relocalize;
   /// False: the poses only, nothing integrated (`map --poses-only`); the map opener is not
   /// called.
   bool integrate = true;

@@ -35,8 +35,31 @@ std::string metres(double value) {
   return std::string(text, end);
 }
 
-/// The old map's voxel size and tau win over values that were not set; a value set
-/// explicitly (config file, --set or an option), even to the default, must be the old map's.
+/// Copies every chunk of `from` into `to`.
+size_t copy_chunks(storage::ChunkStore& from, storage::ChunkStore& to) {
+  size_t copied = 0;
+  for (const storage::ChunkKey& key : from.keys()) {
+    if (std::optional<storage::Chunk> chunk = from.read(key)) {
+      to.write(key, *chunk);
+      ++copied;
+    }
+  }
+  return copied;
+}
+
+}  // namespace
+
+slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses) {
+  slam::Trajectory trajectory;
+  for (const storage::TrajectoryPose& p : poses) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::Quaterniond(p.qw, p.qx, p.qy, p.qz).normalized().toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(p.x, p.y, p.z);
+    trajectory.push_back(static_cast<int64_t>(std::llround(p.t_s * 1e9)), pose);
+  }
+  return trajectory;
+}
+
 void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
                         config::Config& config) {
   const auto adopt = [&](const std::string& key, double& value, double old_value) {
@@ -55,31 +78,6 @@ void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& 
   adopt("map.voxel_size", config.map.voxel_size_m, old_map.voxel_size_m);
   adopt("map.truncation", config.map.truncation_m, old_map.truncation_m);
 }
-
-slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses) {
-  slam::Trajectory trajectory;
-  for (const storage::TrajectoryPose& p : poses) {
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = Eigen::Quaterniond(p.qw, p.qx, p.qy, p.qz).normalized().toRotationMatrix();
-    pose.translation() = Eigen::Vector3d(p.x, p.y, p.z);
-    trajectory.push_back(static_cast<int64_t>(std::llround(p.t_s * 1e9)), pose);
-  }
-  return trajectory;
-}
-
-/// Copies every chunk of `from` into `to`.
-size_t copy_chunks(storage::ChunkStore& from, storage::ChunkStore& to) {
-  size_t copied = 0;
-  for (const storage::ChunkKey& key : from.keys()) {
-    if (std::optional<storage::Chunk> chunk = from.read(key)) {
-      to.write(key, *chunk);
-      ++copied;
-    }
-  }
-  return copied;
-}
-
-}  // namespace
 
 std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory) {
   std::vector<storage::TrajectoryPose> poses;

@@ -28,6 +28,15 @@ MapStore open_map_store(const std::filesystem::path& path, config::Config& confi
                         const std::string& sensor_name,
                         const std::optional<std::string>& continue_from, bool overwrite);
 
+/// The old map's voxel size and tau (`what` names it) win over values that were not set; a
+/// value set explicitly (config file, --set or an option), even to the default, must be the
+/// old map's, else ConfigError naming both.
+void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
+                        config::Config& config);
+
+/// The trajectory of a store's poses.
+slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses);
+
 /// The store's trajectory form of `trajectory`.
 std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory);
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace featsense::slam::loops {
 
@@ -14,6 +15,13 @@ CompactCloud::CompactCloud(const std::vector<Eigen::Vector3f>& points) {
     for (int axis = 0; axis < 3; ++axis) coordinates_.push_back(static_cast<int16_t>(q[axis]));
   }
   coordinates_.shrink_to_fit();
+}
+
+CompactCloud CompactCloud::from_coordinates(std::vector<int16_t> coordinates) {
+  coordinates.resize(coordinates.size() / 3 * 3);
+  CompactCloud cloud;
+  cloud.coordinates_ = std::move(coordinates);
+  return cloud;
 }
 
 std::vector<Eigen::Vector3f> CompactCloud::points() const {

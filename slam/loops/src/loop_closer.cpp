@@ -76,18 +76,8 @@ LoopSettings from_config(const config::Config& config) {
   return settings;
 }
 
-double LoopCloser::drift_radius_m(size_t query) const {
-  return settings_.drift_base_m +
-         settings_.drift_per_m * std::max(0.0, keyframes_[query].travelled_m - last_closure_m_);
-}
-
-double LoopCloser::drift_radius_deg(size_t query) const {
-  return settings_.drift_base_deg +
-         settings_.drift_deg_per_m * std::max(0.0, keyframes_[query].travelled_m - last_closure_m_);
-}
-
-Matrix6d LoopCloser::information(const Matrix6d& hessian, size_t points, double fitness_m,
-                                 double travelled_m) const {
+Matrix6d edge_information(const LoopSettings& settings, const Matrix6d& hessian, size_t points,
+                          double fitness_m, double travelled_m) {
   Matrix6d covariance = Matrix6d::Zero();
   if (points >= 6 && hessian.allFinite()) {
     // The Hessian's shape (which directions the fit pins down), at the scale of the fit's
@@ -102,17 +92,26 @@ Matrix6d LoopCloser::information(const Matrix6d& hessian, size_t points, double 
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(shape.bottomRightCorner<3, 3>())
             .eigenvalues()
             .minCoeff();
-    const double sigma_m = std::max(fitness_m, settings_.min_sigma_m);
+    const double sigma_m = std::max(fitness_m, settings.min_sigma_m);
     if (best_translation > 0.0)
       covariance = shape * (sigma_m * sigma_m / kEffectivePoints / best_translation);
   }
-  const double sigma_rad =
-      settings_.min_sigma_rad + settings_.odometry_sigma_rad_per_m * travelled_m;
-  const double sigma_m = settings_.min_sigma_m + settings_.odometry_sigma_per_m * travelled_m;
+  const double sigma_rad = settings.min_sigma_rad + settings.odometry_sigma_rad_per_m * travelled_m;
+  const double sigma_m = settings.min_sigma_m + settings.odometry_sigma_per_m * travelled_m;
   covariance.diagonal().head<3>().array() += sigma_rad * sigma_rad;
   covariance.diagonal().tail<3>().array() += sigma_m * sigma_m;
   Matrix6d out = covariance.inverse();
   return 0.5 * (out + out.transpose());
+}
+
+double LoopCloser::drift_radius_m(size_t query) const {
+  return settings_.drift_base_m +
+         settings_.drift_per_m * std::max(0.0, keyframes_[query].travelled_m - last_closure_m_);
+}
+
+double LoopCloser::drift_radius_deg(size_t query) const {
+  return settings_.drift_base_deg +
+         settings_.drift_deg_per_m * std::max(0.0, keyframes_[query].travelled_m - last_closure_m_);
 }
 
 refine::GaussianCloud LoopCloser::target_around(size_t keyframe) const {
@@ -212,7 +211,7 @@ void LoopCloser::add_odometry_edge(size_t keyframe, const refine::GaussianCloud&
         refine::measure_fit(voxels, cloud, edge.T_from_to, settings_.vgicp.inlier_distance_m)
             .fitness_m;
   }
-  edge.information = information(hessian, terms, fitness_m, travelled_m);
+  edge.information = edge_information(settings_, hessian, terms, fitness_m, travelled_m);
   graph_.add_edge(edge);
 }
 
@@ -323,7 +322,8 @@ bool LoopCloser::add_keyframe(int64_t stamp_ns, double travelled_m,
       edge.from = best.candidate;
       edge.to = query;
       edge.T_from_to = best.result.T_target_source;
-      edge.information = information(best.result.hessian, cloud.size(), best.result.fitness_m, 0.0);
+      edge.information = edge_information(settings_, best.result.hessian, cloud.size(),
+                                          best.result.fitness_m, 0.0);
       edge.loop = true;
       graph_.add_edge(edge);
       LoopRecord record;
@@ -397,7 +397,8 @@ std::vector<KeyframeRecord> LoopCloser::keyframe_records() const {
   records.reserve(keyframes_.size());
   for (size_t i = 0; i < keyframes_.size(); ++i) {
     const Keyframe& keyframe = keyframes_[i];
-    records.push_back({keyframe.stamp_ns, graph_.pose(i), keyframe.descriptor, keyframe.cloud});
+    records.push_back({keyframe.stamp_ns, keyframe.travelled_m, graph_.pose(i), keyframe.descriptor,
+                       keyframe.cloud});
   }
   return records;
 }

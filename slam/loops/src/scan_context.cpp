@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace featsense::slam::loops {
 namespace {
@@ -23,6 +25,16 @@ float ground_height(const std::vector<Eigen::Vector3f>& points, double min_range
   std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k),
                    heights.end());
   return heights[k];
+}
+
+/// Per ring, the fraction of its sectors that hold a point.
+void fill_ring_key(ScanContext& context) {
+  context.ring_key.assign(static_cast<size_t>(context.rings), 0.0f);
+  for (int r = 0; r < context.rings; ++r) {
+    int occupied = 0;
+    for (int s = 0; s < context.sectors; ++s) occupied += context.at(r, s) > 0.0f ? 1 : 0;
+    context.ring_key[static_cast<size_t>(r)] = static_cast<float>(occupied) / context.sectors;
+  }
 }
 
 }  // namespace
@@ -50,12 +62,24 @@ ScanContext make_scan_context(const std::vector<Eigen::Vector3f>& levelled_point
     float& bin = out.bins[static_cast<size_t>(ring * settings.sectors + sector)];
     bin = std::max(bin, height);
   }
-  out.ring_key.assign(static_cast<size_t>(settings.rings), 0.0f);
-  for (int r = 0; r < settings.rings; ++r) {
-    int occupied = 0;
-    for (int s = 0; s < settings.sectors; ++s) occupied += out.at(r, s) > 0.0f ? 1 : 0;
-    out.ring_key[static_cast<size_t>(r)] = static_cast<float>(occupied) / settings.sectors;
+  fill_ring_key(out);
+  return out;
+}
+
+ScanContext scan_context_from_bins(int rings, int sectors, std::vector<float> bins) {
+  if (rings < 1 || sectors < 1 || bins.size() != static_cast<size_t>(rings) * sectors)
+    throw std::invalid_argument("scan context: " + std::to_string(bins.size()) + " bins are not " +
+                                std::to_string(rings) + " rings x " + std::to_string(sectors) +
+                                " sectors");
+  for (const float bin : bins) {
+    if (!std::isfinite(bin) || bin < 0.0f)
+      throw std::invalid_argument("scan context: a bin is negative or not finite");
   }
+  ScanContext out;
+  out.rings = rings;
+  out.sectors = sectors;
+  out.bins = std::move(bins);
+  fill_ring_key(out);
   return out;
 }
 

@@ -118,6 +118,11 @@ struct LoopConfig {
   double gravity_window_s = 4.0;
 };
 
+struct RelocalizeConfig {
+  int max_scans = 600;
+  int confirmations = 2;
+};
+
 struct Config {
   SensorConfig sensor;
   MapConfig map;
@@ -125,6 +130,7 @@ struct Config {
   OdometryConfig odometry;
   RefineConfig refine;
   LoopConfig loop;
+  RelocalizeConfig relocalize;
   /// The keys given a value explicitly (by the YAML file, a --set or a command-line option
   /// that stands for the key), each with where the value that counts came from: "my.yaml:12",
   /// "--set map.voxel_size=0.05", "--voxel 0.05". A key is here even when the value given

@@ -18,6 +18,9 @@ class CompactCloud {
   CompactCloud() = default;
   /// Points beyond the 16-bit range, or not finite, are dropped.
   explicit CompactCloud(const std::vector<Eigen::Vector3f>& points);
+  /// The cloud a map file kept (coordinates()); a count that is not a multiple of 3 drops the
+  /// incomplete last point.
+  static CompactCloud from_coordinates(std::vector<int16_t> coordinates);
 
   std::vector<Eigen::Vector3f> points() const;
   size_t size() const { return coordinates_.size() / 3; }

@@ -85,6 +85,12 @@ struct LoopSettings {
 /// loop.* of `config`.
 LoopSettings from_config(const config::Config& config);
 
+/// The information of an edge measured by a registration: the shape of its Hessian (over
+/// `points` terms) at the scale of its fitness, plus the odometry's drift over `travelled_m`
+/// and the settings' floor. Without a Hessian (0 points): the drift and the floor alone.
+Matrix6d edge_information(const LoopSettings& settings, const Matrix6d& hessian, size_t points,
+                          double fitness_m, double travelled_m);
+
 /// Picks the keyframes among the scans, in order: the first, then one every `distance_m`
 /// travelled or `angle_deg` turned since the last keyframe.
 class KeyframeSelector {
@@ -140,6 +146,7 @@ struct LoopCounts {
 /// descriptor and its points.
 struct KeyframeRecord {
   int64_t stamp_ns = 0;
+  double travelled_m = 0.0;  ///< along its run's path
   Eigen::Isometry3d T_map_sensor = Eigen::Isometry3d::Identity();
   ScanContext descriptor;
   CompactCloud cloud;
@@ -200,8 +207,6 @@ class LoopCloser {
   double drift_radius_m(size_t query) const;
   double drift_radius_deg(size_t query) const;
   refine::GaussianCloud target_around(size_t keyframe) const;
-  Matrix6d information(const Matrix6d& hessian, size_t points, double fitness_m,
-                       double travelled_m) const;
   void add_odometry_edge(size_t keyframe, const refine::GaussianCloud& cloud);
   PoseGraphSummary optimise_timed();
 

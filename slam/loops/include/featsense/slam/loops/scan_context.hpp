@@ -43,6 +43,10 @@ struct ScanContext {
 ScanContext make_scan_context(const std::vector<Eigen::Vector3f>& levelled_points,
                               const ScanContextSettings& settings = {});
 
+/// A descriptor kept as its bins (a map file's): the ring key is made from them. Throws
+/// std::invalid_argument where the bins are not rings x sectors finite values.
+ScanContext scan_context_from_bins(int rings, int sectors, std::vector<float> bins);
+
 /// The sensor frame turned so that z is up, the heading kept: points p of the sensor frame go
 /// to levelling(T_map_sensor) * p.
 Eigen::Matrix3d levelling(const Eigen::Isometry3d& T_map_sensor);

@@ -1,0 +1,108 @@
+#pragma once
+/// Places a new recording in a saved map: each keyframe of the new session (its pose in the
+/// session's own frame, which starts at its first scan) is matched against the map's
+/// keyframes as a loop would be (ring keys, then the full Scan Context match with its yaw),
+/// and the best few candidates at distinct places are verified by voxelized GICP. A keyframe
+/// whose verified candidates put it at two places is ambiguous (a block like another one) and
+/// places nothing. Each unambiguous match says where the session's frame lies in the map;
+/// the session is placed once `confirmations` keyframes agree on it (a single good-looking
+/// fit is a guess, and the map is never merged on a guess). A user's guess of the session's
+/// frame adds the map keyframes around it as candidates; it is verified like any other.
+/// Not thread-safe: one caller, keyframes in order.
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/loops/map_keyframe.hpp"
+
+namespace featsense::slam::loops {
+
+struct RelocalizeSettings {
+  /// Descriptor distance, verification (VGICP, fitness, inliers), the keyframes' points and
+  /// the odometry's drift, as for loops.
+  LoopSettings loop;
+  /// Map keyframes compared in full after the ring keys, and how many of those (at distinct
+  /// places) are verified for each keyframe.
+  size_t ring_candidates = 20;
+  size_t verifications = 4;
+  /// Keyframes that must agree on the session's place, and how closely (plus the odometry's
+  /// drift between them).
+  size_t confirmations = 2;
+  double agreement_m = 0.5;
+  double agreement_deg = 2.0;
+  /// A user's guess of T_map_session, and how far the truth may lie from it.
+  std::optional<Eigen::Isometry3d> guess;
+  double guess_radius_m = 10.0;
+  size_t guess_candidates = 3;
+};
+
+/// Why a candidate or a keyframe did not place the session.
+struct RelocalizationCounts {
+  size_t keyframes = 0;
+  size_t candidates = 0;
+  size_t verified = 0;
+  std::map<std::string, size_t> rejected;  ///< by reason
+  std::vector<double> keyframe_ms;
+};
+
+/// The match that placed the session.
+struct Relocalization {
+  Eigen::Isometry3d T_map_session = Eigen::Isometry3d::Identity();
+  size_t keyframe = 0;      ///< the new session's keyframe (count, from 0) that confirmed it
+  size_t map_keyframe = 0;  ///< the map keyframe it matched (index into the map's keyframes)
+  int64_t stamp_ns = 0;
+  std::string found_by;  ///< "descriptor" or "guess"
+  double descriptor_distance = 1.0;
+  double fitness_m = 0.0;
+  double inlier_fraction = 0.0;
+  size_t agreeing = 0;  ///< keyframes that agreed on it, this one included
+};
+
+class Relocalizer {
+ public:
+  /// `map` sorted by (session, index), each keyframe's travelled_m filled.
+  Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings);
+
+  /// The next keyframe of the new session: its stamp, its front-end pose in the session's
+  /// frame, how far along the session's path, its points in the sensor frame (deskewed,
+  /// thinned). Returns the placement once confirmed (and every call after that).
+  std::optional<Relocalization> add_keyframe(int64_t stamp_ns,
+                                             const Eigen::Isometry3d& T_session_sensor,
+                                             double travelled_m,
+                                             const std::vector<Eigen::Vector3f>& points);
+
+  const std::optional<Relocalization>& placement() const { return placement_; }
+  const RelocalizationCounts& counts() const { return counts_; }
+  const std::vector<MapKeyframe>& map() const { return map_; }
+
+ private:
+  struct Candidate {
+    size_t map_keyframe = 0;
+    Eigen::Isometry3d guess;  ///< T_candidate_query
+    std::string found_by;
+    double descriptor_distance = 1.0;
+  };
+  struct Hypothesis {
+    size_t keyframe = 0;
+    double travelled_m = 0.0;
+    Eigen::Isometry3d T_map_session;
+  };
+  std::vector<Candidate> candidates(const ScanContext& descriptor,
+                                    const Eigen::Isometry3d& T_session_sensor) const;
+  bool agree(const Hypothesis& a, const Hypothesis& b) const;
+
+  std::vector<MapKeyframe> map_;
+  std::vector<Eigen::Isometry3d> map_poses_;
+  RelocalizeSettings settings_;
+  std::vector<Hypothesis> hypotheses_;
+  std::optional<Relocalization> placement_;
+  RelocalizationCounts counts_;
+};
+
+}  // namespace featsense::slam::loops

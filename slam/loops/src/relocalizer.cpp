@@ -1,0 +1,201 @@
+#include "featsense/slam/loops/relocalizer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "featsense/slam/trajectory/trajectory_metrics.hpp"
+
+namespace featsense::slam::loops {
+namespace {
+
+/// Candidates closer than this to one already chosen see the same surroundings and would
+/// verify to the same place: the verifications go to distinct places instead (a twin block
+/// is tens of metres away).
+constexpr double kDistinctPlacesM = 4.0;
+
+bool near_any(const std::vector<size_t>& chosen, const std::vector<Eigen::Isometry3d>& poses,
+              size_t candidate) {
+  return std::any_of(chosen.begin(), chosen.end(), [&](size_t c) {
+    return (poses[c].translation() - poses[candidate].translation()).norm() < kDistinctPlacesM;
+  });
+}
+
+}  // namespace
+
+Relocalizer::Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings)
+    : map_(std::move(map)), settings_(settings) {
+  map_poses_.reserve(map_.size());
+  for (const MapKeyframe& keyframe : map_) map_poses_.push_back(keyframe.T_map_sensor);
+}
+
+std::vector<Relocalizer::Candidate> Relocalizer::candidates(
+    const ScanContext& descriptor, const Eigen::Isometry3d& T_session_sensor) const {
+  std::vector<Candidate> out;
+  std::vector<size_t> chosen;
+  // The user's guess first: the map keyframes nearest where it puts the scan.
+  if (settings_.guess) {
+    const Eigen::Isometry3d T_map_query = *settings_.guess * T_session_sensor;
+    std::vector<std::pair<double, size_t>> by_distance;
+    for (size_t j = 0; j < map_.size(); ++j) {
+      const double d = (map_poses_[j].translation() - T_map_query.translation()).norm();
+      if (d <= settings_.guess_radius_m) by_distance.emplace_back(d, j);
+    }
+    std::sort(by_distance.begin(), by_distance.end());
+    size_t added = 0;
+    for (const auto& [d, j] : by_distance) {
+      if (added == settings_.guess_candidates) break;
+      if (near_any(chosen, map_poses_, j)) continue;
+      out.push_back({j, map_poses_[j].inverse() * T_map_query, "guess", 1.0});
+      chosen.push_back(j);
+      ++added;
+    }
+  }
+  // By descriptor: the nearest ring keys, then the full match with its yaw.
+  if (descriptor.empty() || map_.empty()) return out;
+  std::vector<std::pair<double, size_t>> by_ring;
+  by_ring.reserve(map_.size());
+  for (size_t j = 0; j < map_.size(); ++j) {
+    if (map_[j].descriptor.rings != descriptor.rings ||
+        map_[j].descriptor.sectors != descriptor.sectors)
+      continue;
+    by_ring.emplace_back(ring_key_distance(descriptor, map_[j].descriptor), j);
+  }
+  const size_t keep = std::min(settings_.ring_candidates, by_ring.size());
+  std::partial_sort(by_ring.begin(), by_ring.begin() + static_cast<std::ptrdiff_t>(keep),
+                    by_ring.end());
+  std::vector<std::pair<ScanContextMatch, size_t>> matches;
+  for (size_t k = 0; k < keep; ++k) {
+    const size_t j = by_ring[k].second;
+    const ScanContextMatch m = match(descriptor, map_[j].descriptor);
+    if (m.distance <= settings_.loop.max_descriptor_distance) matches.emplace_back(m, j);
+  }
+  std::sort(matches.begin(), matches.end(),
+            [](const auto& a, const auto& b) { return a.first.distance < b.first.distance; });
+  const Eigen::Matrix3d L_query = levelling(T_session_sensor);
+  size_t added = 0;
+  for (const auto& [m, j] : matches) {
+    if (added == settings_.verifications) break;
+    if (near_any(chosen, map_poses_, j)) continue;
+    // Turned by the descriptor's yaw between the two levelled frames, no translation.
+    Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+    guess.linear() = levelling(map_poses_[j]).transpose() *
+                     Eigen::AngleAxisd(m.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                     L_query;
+    out.push_back({j, guess, "descriptor", m.distance});
+    chosen.push_back(j);
+    ++added;
+  }
+  return out;
+}
+
+bool Relocalizer::agree(const Hypothesis& a, const Hypothesis& b) const {
+  const double apart_m = std::abs(a.travelled_m - b.travelled_m);
+  const double tolerance_m = settings_.agreement_m + settings_.loop.drift_per_m * apart_m;
+  const double tolerance_deg = settings_.agreement_deg + settings_.loop.drift_deg_per_m * apart_m;
+  return (a.T_map_session.translation() - b.T_map_session.translation()).norm() <= tolerance_m &&
+         rotation_angle_deg(a.T_map_session.rotation().transpose() * b.T_map_session.rotation()) <=
+             tolerance_deg;
+}
+
+std::optional<Relocalization> Relocalizer::add_keyframe(
+    int64_t stamp_ns, const Eigen::Isometry3d& T_session_sensor, double travelled_m,
+    const std::vector<Eigen::Vector3f>& points) {
+  if (placement_) return placement_;
+  const auto start = std::chrono::steady_clock::now();
+  const size_t keyframe = counts_.keyframes++;
+  const auto done = [&] {
+    counts_.keyframe_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+  };
+  const LoopSettings& loop = settings_.loop;
+  const Eigen::Matrix3f L = levelling(T_session_sensor).cast<float>();
+  // The points as the map keeps its keyframes' (centimetres), so both sides are alike.
+  const std::vector<Eigen::Vector3f> kept = CompactCloud(points).points();
+  std::vector<Eigen::Vector3f> levelled;
+  levelled.reserve(kept.size());
+  for (const Eigen::Vector3f& p : kept) levelled.push_back(L * p);
+  const ScanContext descriptor = make_scan_context(levelled, loop.scan_context);
+  const std::vector<Candidate> found = candidates(descriptor, T_session_sensor);
+  counts_.candidates += found.size();
+  if (found.empty()) {
+    done();
+    return std::nullopt;
+  }
+  const refine::GaussianCloud cloud = refine::with_covariances(kept, loop.neighbours);
+  const auto reject = [&](const char* reason) { ++counts_.rejected[reason]; };
+  struct Verified {
+    const Candidate* candidate;
+    refine::VgicpResult result;
+    Eigen::Isometry3d T_map_query;
+  };
+  std::vector<Verified> verified;
+  for (const Candidate& candidate : found) {
+    const refine::GaussianCloud target = keyframe_target(map_, map_poses_, candidate.map_keyframe,
+                                                         loop.target_neighbours, loop.neighbours);
+    const refine::VgicpResult result = refine::align(target, cloud, candidate.guess, loop.vgicp);
+    if (!result.converged) {
+      reject("not converged");
+    } else if (result.fitness_m > loop.max_fitness_m) {
+      reject("fitness");
+    } else if (result.inlier_fraction < loop.min_inlier_fraction) {
+      reject("inliers");
+    } else {
+      const Eigen::Isometry3d T_map_query =
+          map_poses_[candidate.map_keyframe] * result.T_target_source;
+      if (candidate.found_by == "guess" &&
+          (T_map_query.translation() - (*settings_.guess * T_session_sensor).translation()).norm() >
+              settings_.guess_radius_m) {
+        reject("away from the guess");
+        continue;
+      }
+      ++counts_.verified;
+      verified.push_back({&candidate, result, T_map_query});
+    }
+  }
+  if (verified.empty()) {
+    done();
+    return std::nullopt;
+  }
+  for (size_t a = 0; a < verified.size(); ++a) {
+    for (size_t b = a + 1; b < verified.size(); ++b) {
+      if ((verified[a].T_map_query.translation() - verified[b].T_map_query.translation()).norm() >
+          loop.ambiguity_m) {
+        counts_.rejected["ambiguous"] += verified.size();
+        done();
+        return std::nullopt;
+      }
+    }
+  }
+  const Verified& best = *std::min_element(
+      verified.begin(), verified.end(),
+      [](const Verified& a, const Verified& b) { return a.result.fitness_m < b.result.fitness_m; });
+  const Hypothesis hypothesis{keyframe, travelled_m, best.T_map_query * T_session_sensor.inverse()};
+  size_t agreeing = 1;
+  size_t disagreeing = 0;
+  for (const Hypothesis& earlier : hypotheses_)
+    (agree(earlier, hypothesis) ? agreeing : disagreeing)++;
+  hypotheses_.push_back(hypothesis);
+  // Confirmed by enough keyframes, and by more than any other place was.
+  if (agreeing >= settings_.confirmations && agreeing > disagreeing) {
+    Relocalization placed;
+    placed.T_map_session = hypothesis.T_map_session;
+    placed.keyframe = keyframe;
+    placed.map_keyframe = best.candidate->map_keyframe;
+    placed.stamp_ns = stamp_ns;
+    placed.found_by = best.candidate->found_by;
+    placed.descriptor_distance = best.candidate->descriptor_distance;
+    placed.fitness_m = best.result.fitness_m;
+    placed.inlier_fraction = best.result.inlier_fraction;
+    placed.agreeing = agreeing;
+    placement_ = placed;
+  } else {
+    reject(disagreeing > 0 ? "disagrees with an earlier match" : "awaiting confirmation");
+  }
+  done();
+  return placement_;
+}
+
+}  // namespace featsense::slam::loops
