@@ -222,7 +222,11 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
 
   // The run as the map's session: with given poses they place it; the odometry's map frame
   // is the first scan's, or the true first pose's where the truth is known.
-  SessionDescription session{info.path, info.format, "given poses"};
+  // The input's absolute path: a later session may map it again from elsewhere.
+  std::error_code no_path;
+  const fs::path absolute_input = fs::absolute(info.path, no_path);
+  SessionDescription session{no_path ? info.path : absolute_input.lexically_normal().string(),
+                             info.format, "given poses"};
   if (odometry) {
     session.placement =
         truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from

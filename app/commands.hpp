@@ -34,6 +34,8 @@ Command register_map(CLI::App& app, const CliContext& context);
 std::vector<Command> register_bench(CLI::App& app, const CliContext& context);
 /// `featsense eval traj|mesh ...`: figures against ground truth (one command per subcommand).
 std::vector<Command> register_eval(CLI::App& app, const CliContext& context);
+/// `featsense merge A.h5 B.h5 -o C.h5`: two maps of one place as one.
+Command register_merge(CLI::App& app, const CliContext& context);
 /// `featsense export MESH -o FILE`: a mesh in another format, chosen by the extension.
 Command register_export(CLI::App& app, const CliContext& context);
 /// `featsense mesh MAP -o MESH`: marching cubes over a stored map.

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
                                                    featsense::app::register_convert(app, context),
                                                    featsense::app::register_simulate(app, context),
                                                    featsense::app::register_map(app, context),
+                                                   featsense::app::register_merge(app, context),
                                                    featsense::app::register_demo(app, context),
                                                    featsense::app::register_export(app, context),
                                                    featsense::app::register_navmesh(app, context),

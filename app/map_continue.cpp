@@ -93,8 +93,9 @@ slam::Trajectory moved_by(const Eigen::Isometry3d& T, const slam::Trajectory& pa
   return out;
 }
 
-/// Why the earlier sessions cannot be mapped again (empty: they can).
-std::string why_not_reintegrated(const SavedMap& saved, const config::Config& config) {
+}  // namespace
+
+std::string why_sessions_cannot_be_read(const SavedMap& saved, const config::Config& config) {
   for (const SavedSession& s : saved.sessions) {
     const std::string name = "session " + std::to_string(s.session.id);
     if (s.poses.size() == 0) return name + " has no poses of its own in the map file";
@@ -120,7 +121,27 @@ std::vector<slam::loops::KeyframeRecord> records_of(const std::vector<MapKeyfram
   return out;
 }
 
-}  // namespace
+void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
+                    const PipelineSettings& replay, config::Config& config,
+                    const std::string& sensor_name) {
+  for (size_t s = 0; s < sessions.size(); ++s) {
+    const SessionRemap& session = sessions[s];
+    spdlog::info("mapping {} again with its corrected poses", session.description.input);
+    InputOptions input;
+    input.input = session.description.input;
+    const std::unique_ptr<slam::ScanSource> source = input.open(config);
+    const std::unique_ptr<slam::ScanLocator> locator =
+        slam::make_given_pose_locator(session.poses, config.odometry.deskew);
+    PipelineSettings pipeline = replay;
+    pipeline.range = {};
+    pipeline.total_frames = source->info().frames;
+    const MapPassOutput pass = run_map_pass(
+        *source, *locator, pipeline, config,
+        {into, sensor_name, s == 0 ? std::nullopt : std::optional<std::string>(into.string()), true,
+         session.description, &session.keyframes});
+    if (pass.result.interrupted) throw Interrupted("interrupted");
+  }
+}
 
 Eigen::Isometry3d parse_initial_pose(const std::string& text) {
   std::vector<double> values;
@@ -254,7 +275,7 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
   run.final_poses = moved_path(placed_path, keyframes, first_new, keyframes.size(), linked.poses);
   const double quarter_voxel_m = 0.25 * saved.metadata.voxel_size_m;
   std::string not_again;
-  if (moved_m > quarter_voxel_m) not_again = why_not_reintegrated(saved, config);
+  if (moved_m > quarter_voxel_m) not_again = why_sessions_cannot_be_read(saved, config);
   const bool again = moved_m > quarter_voxel_m && not_again.empty();
 
   std::map<std::string, size_t> links_between;
@@ -331,34 +352,19 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
   fs::remove(rebuilt, ignored);
   fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
   try {
+    std::vector<SessionRemap> earlier;
     size_t first = 0;
-    for (size_t s = 0; s < saved.sessions.size(); ++s) {
-      const SavedSession& old = saved.sessions[s];
+    for (const SavedSession& old : saved.sessions) {
       size_t end = first;
       while (end < first_new && keyframes[end].session == old.session.id) ++end;
-      spdlog::info("mapping session {} ({}) again: the links moved its keyframes", old.session.id,
-                   old.session.input);
-      InputOptions input;
-      input.input = old.session.input;
-      const std::unique_ptr<slam::ScanSource> old_source = input.open(config);
-      const std::unique_ptr<slam::ScanLocator> locator = slam::make_given_pose_locator(
-          moved_path(old.poses, keyframes, first, end, linked.poses), config.odometry.deskew);
-      const std::vector<slam::loops::KeyframeRecord> records =
-          records_of(keyframes, first, end, linked.poses);
-      PipelineSettings old_replay = replay;
-      old_replay.range = {};
-      old_replay.total_frames = old_source->info().frames;
-      const SessionDescription description{
-          old.session.input, old.session.format,
-          old.session.placement + "; moved by the links of session " + std::to_string(session_id)};
-      const MapPassOutput pass =
-          run_map_pass(*old_source, *locator, old_replay, config,
-                       {rebuilt, request.sensor_name,
-                        s == 0 ? std::nullopt : std::optional<std::string>(rebuilt.string()), true,
-                        description, &records});
-      if (pass.result.interrupted) throw Interrupted("interrupted");
+      earlier.push_back({{old.session.input, old.session.format,
+                          old.session.placement + "; moved by the links of session " +
+                              std::to_string(session_id)},
+                         moved_path(old.poses, keyframes, first, end, linked.poses),
+                         records_of(keyframes, first, end, linked.poses)});
       first = end;
     }
+    remap_sessions(earlier, rebuilt, replay, config, request.sensor_name);
     run.pass = this_recording(rebuilt, rebuilt.string(), true);
     if (run.pass.result.interrupted) throw Interrupted("interrupted");
   } catch (const Interrupted&) {
@@ -372,6 +378,8 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
     throw;
   }
   fs::rename(rebuilt, map_out);
+  // Closed cleanly, its journal holds nothing the file does not.
+  fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
   run.second_pass = "every session mapped again with the corrected poses";
   return run;
 }

@@ -25,6 +25,7 @@
 #include "map_pass.hpp"
 #include "map_pipeline.hpp"
 #include "map_sessions.hpp"
+#include "saved_map.hpp"
 
 namespace featsense::app {
 
@@ -46,6 +47,28 @@ struct ContinueRequest {
   std::string sensor_name;
   bool overwrite = false;
   SessionDescription session;
+  /// Why the sessions of `saved` cannot be mapped again from their inputs (empty: they can).
+  std::string why_sessions_cannot_be_read(const SavedMap& saved, const config::Config& config);
+
+  /// Keyframes [first, end) as a map file records them, at `poses` (same indexing).
+  std::vector<slam::loops::KeyframeRecord> records_of(
+      const std::vector<slam::loops::MapKeyframe>& keyframes, size_t first, size_t end,
+      const std::vector<Eigen::Isometry3d>& poses);
+
+  /// A session to be mapped again: its input and how it was placed, its final poses and
+  /// keyframes.
+  struct SessionRemap {
+    SessionDescription description;
+    slam::Trajectory poses;
+    std::vector<slam::loops::KeyframeRecord> keyframes;
+  };
+
+  /// Maps each session again from its input with its poses (interpolated within each sweep),
+  /// in order, into `into` (replaced). Throws Interrupted, InputError or std::runtime_error.
+  void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
+                      const PipelineSettings& replay, config::Config& config,
+                      const std::string& sensor_name);
+
   /// --initial-pose: where the recording's first scan lies in the map, roughly.
   std::optional<Eigen::Isometry3d> guess;
 };
@@ -65,6 +88,28 @@ struct ContinuedRun {
 ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odometry,
                                 PipelineSettings pipeline, config::Config& config,
                                 const ContinueRequest& request, const SourceReopener& reopen);
+
+/// Why the sessions of `saved` cannot be mapped again from their inputs (empty: they can).
+std::string why_sessions_cannot_be_read(const SavedMap& saved, const config::Config& config);
+
+/// Keyframes [first, end) as a map file records them, at `poses` (same indexing).
+std::vector<slam::loops::KeyframeRecord> records_of(
+    const std::vector<slam::loops::MapKeyframe>& keyframes, size_t first, size_t end,
+    const std::vector<Eigen::Isometry3d>& poses);
+
+/// A session to be mapped again: its input and how it was placed, its final poses and
+/// keyframes.
+struct SessionRemap {
+  SessionDescription description;
+  slam::Trajectory poses;
+  std::vector<slam::loops::KeyframeRecord> keyframes;
+};
+
+/// Maps each session again from its input with its poses (interpolated within each sweep),
+/// in order, into `into` (replaced). Throws Interrupted, InputError or std::runtime_error.
+void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
+                    const PipelineSettings& replay, config::Config& config,
+                    const std::string& sensor_name);
 
 /// --initial-pose "x,y,z,yaw_deg" as a pose (map <- the recording's first scan). Throws
 /// ConfigError.

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# On the GPU machine, from the repository root, with .device/bundle.tar.xz carried along: one
+# map from several recordings. `continue` (default): the town loop mapped, then the town drive
+# (starts 50 m away, turned 90 deg, another path) continued into it without poses: where it was
+# placed against its truth, the merged map's mesh against the true surface; then the lab
+# continued into that map (must be refused, the map byte-identical). `merge` (after
+# `continue`, same warm machine): the drive mapped alone in its own frame, then merged into
+# the loop's map, and the same figures. Results go to $OUT.
+# Usage: bash test/bench/run_gpu_sessions.sh [continue|merge]
+set -uo pipefail
+tar xJf .device/bundle.tar.xz -C /tmp
+export LD_LIBRARY_PATH=/tmp/bundle/lib
+f=/tmp/bundle/bin/featsense
+out=${OUT:-/tmp/out}
+mkdir -p "$out"
+root=$(pwd)
+nvidia-smi --query-gpu=name,memory.total --format=csv,noheader
+lscpu | grep "Model name"
+w=/tmp/sessions
+mkdir -p "$w"
+cd "$w"
+timed() {  # name, command...
+  local name=$1
+  shift
+  /usr/bin/time -f "$name: %e s, peak RSS %M kB" "$@" 2>> "$out/time.txt" > /dev/null
+  local rc=$?
+  tail -1 "$out/time.txt"
+  return $rc
+}
+mesh_figures() {  # label, mesh
+  "$f" -q eval mesh "$2" A/gt_mesh.ply --json "$out/eval_$1.json" > /dev/null &&
+    python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1])); a = d.get('accuracy', d)
+print(sys.argv[2], 'mesh vs truth:', json.dumps(a)[:400])" "$out/eval_$1.json" "$1"
+}
+if [ "${1:-continue}" = continue ]; then
+  rm -rf A B L MA MB ML
+  timed "simulate town loop" "$f" -q simulate --scene town --path loop -o A
+  timed "simulate town drive" "$f" -q simulate --scene town --path drive -o B
+  timed "simulate lab walk" "$f" -q simulate --scene lab --path walk --frames 300 -o L
+  timed "map loop (cuda)" "$f" -q map A -o MA --backend cuda
+  cp MA/report.json "$out/loop_report.json"
+  timed "continue with the drive (cuda)" "$f" -q map B --continue MA/map.h5 -o MB --backend cuda
+  cp MB/report.json "$out/drive_report.json"
+  cp MB/trajectory.tum "$out/drive_trajectory.tum"
+  python3 "$root/test/bench/pose_error.py" MB/trajectory.tum B/gt_trajectory.tum "drive placed, vs truth"
+  python3 -c "
+import json
+r = json.load(open('MB/report.json')); l = r['relocalization']; m = r.get('eval', {}).get('mesh', {})
+print('placed', l['placed'], 'at', l['seconds_in'], 's, keyframe', l['keyframe'], 'fitness', l['fitness_m'],
+      'agreeing', l['agreeing'], 'links', l['links']['count'], 'earlier sessions', json.dumps(l['earlier_sessions']))
+print('mesh', json.dumps(m)[:600])
+print('sessions', [(s['id'], s['scans'], s['keyframes']) for s in r['sessions']])"
+  sha256sum MB/map.h5 > "$out/before_lab.sha256"
+  "$f" -q map L --continue MB/map.h5 -o ML --backend cuda 2> "$out/lab_refused.txt"
+  echo "lab into town: exit $?, $(tail -c 600 "$out/lab_refused.txt")"
+  sha256sum -c "$out/before_lab.sha256"
+else
+  rm -rf B2 MB2 MM.*
+  mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done
+  timed "map the drive alone (cuda)" "$f" -q map B2 -o MB2 --backend cuda --no-mesh
+  timed "merge (cuda)" "$f" -q merge MA/map.h5 MB2/map.h5 -o MM.h5 --backend cuda
+  cp MM.report.json "$out/merge_report.json"
+  python3 "$root/test/bench/pose_error.py" MM.session1.tum B/gt_trajectory.tum "drive merged, vs truth"
+  python3 "$root/test/bench/pose_error.py" MM.session0.tum A/gt_trajectory.tum "loop merged, vs truth"
+  timed "mesh merged" "$f" -q mesh MM.h5 -o MM.ply
+  mesh_figures merged MM.ply
+  mesh_figures continued MB/mesh.ply
+fi

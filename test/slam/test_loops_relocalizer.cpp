@@ -1,0 +1,151 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <vector>
+
+#include "common/test_poses.hpp"
+#include "featsense/slam/loops/relocalizer.hpp"
+#include "featsense/slam/loops/session_links.hpp"
+#include "featsense/slam/sim/scene_library.hpp"
+#include "featsense/slam/trajectory/trajectory_metrics.hpp"
+#include "scene_sampling.hpp"
+
+namespace featsense::slam::loops {
+namespace {
+
+using test::pose;
+
+/// The scene around the sensor at its true pose, in its own frame (one point per 0.4 m voxel
+/// of an outdoor scan, about), a fresh noisy sampling each time.
+std::vector<Eigen::Vector3f> scan_at(const mesh::TriangleMesh& scene, const Eigen::Isometry3d& T,
+                                     uint32_t seed) {
+  std::vector<Eigen::Vector3f> points =
+      test::sample_scene(scene, T.translation().cast<float>(), 40.0f, 6000, 0.02f, seed);
+  const Eigen::Isometry3d T_sensor_map = T.inverse();
+  for (Eigen::Vector3f& p : points) p = (T_sensor_map * p.cast<double>()).cast<float>();
+  return points;
+}
+
+/// A map of one session: a keyframe every 2 m along the parking lot's middle lane, eastbound.
+std::vector<MapKeyframe> lane_map(const mesh::TriangleMesh& scene, uint32_t session,
+                                  const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<MapKeyframe> map;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    MapKeyframe keyframe;
+    keyframe.session = session;
+    keyframe.index = static_cast<uint32_t>(i);
+    keyframe.stamp_ns = static_cast<int64_t>(i) * 400'000'000;
+    keyframe.T_map_sensor = poses[i];
+    const std::vector<Eigen::Vector3f> points = scan_at(scene, poses[i], 100 + session * 1000 + i);
+    keyframe.descriptor = make_scan_context(points);  // level poses: the sensor frame is level
+    keyframe.cloud = CompactCloud(points);
+    map.push_back(std::move(keyframe));
+  }
+  travelled_from_positions(map);
+  return map;
+}
+
+std::vector<Eigen::Isometry3d> eastbound(double from_x, double to_x) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (double x = from_x; x <= to_x; x += 2.0) poses.push_back(pose(0.0, 0.0, 0.0, {x, 10.5, 1.9}));
+  return poses;
+}
+
+/// Westbound in the north lane: the map's places seen the other way round.
+std::vector<Eigen::Isometry3d> westbound(double from_x, double to_x) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (double x = from_x; x >= to_x; x -= 2.0)
+    poses.push_back(pose(M_PI, 0.0, 0.0, {x, 12.0, 1.9}));
+  return poses;
+}
+
+TEST(Relocalizer, PlacesARecordingThatStartsFarAwayTurnedTheOtherWay) {
+  const mesh::TriangleMesh scene = build_scene("parking");
+  Relocalizer relocalizer(lane_map(scene, 0, eastbound(6.0, 58.0)), RelocalizeSettings{});
+  // The new recording starts 44 m from the map's first keyframe, turned 180 degrees: its own
+  // frame is its first pose.
+  const std::vector<Eigen::Isometry3d> truth = westbound(50.0, 20.0);
+  const Eigen::Isometry3d T_map_session = truth.front();
+  std::optional<Relocalization> placed;
+  for (size_t k = 0; k < truth.size() && !placed; ++k) {
+    placed = relocalizer.add_keyframe(static_cast<int64_t>(k) * 400'000'000,
+                                      T_map_session.inverse() * truth[k], 2.0 * k,
+                                      scan_at(scene, truth[k], static_cast<uint32_t>(k)));
+  }
+  ASSERT_TRUE(placed) << relocalizer.counts().candidates << " candidates, "
+                      << relocalizer.counts().verified << " verified";
+  EXPECT_GE(placed->agreeing, 2u);  // one match is a guess
+  EXPECT_LT((placed->T_map_session.translation() - T_map_session.translation()).norm(), 0.1);
+  EXPECT_LT(
+      rotation_angle_deg(placed->T_map_session.rotation().transpose() * T_map_session.rotation()),
+      1.0);
+}
+
+TEST(Relocalizer, DoesNotPlaceARecordingOfAnotherPlace) {
+  const mesh::TriangleMesh parking = build_scene("parking");
+  const mesh::TriangleMesh corridor = build_scene("corridor");
+  Relocalizer relocalizer(lane_map(parking, 0, eastbound(6.0, 58.0)), RelocalizeSettings{});
+  for (size_t k = 0; k < 20; ++k) {
+    const Eigen::Isometry3d T = pose(0.0, 0.0, 0.0, {2.0 + 2.0 * k, 0.0, 1.5});
+    EXPECT_FALSE(relocalizer.add_keyframe(static_cast<int64_t>(k) * 1'000'000'000, T, 2.0 * k,
+                                          scan_at(corridor, T, static_cast<uint32_t>(k))));
+  }
+  EXPECT_EQ(relocalizer.counts().keyframes, 20u);
+}
+
+TEST(Relocalizer, AGuessOutsideTheMapPlacesNothing) {
+  // A user's guess is verified like any match: one that puts the recording where the map has
+  // no keyframe adds no candidate, and the descriptor still finds the true place.
+  const mesh::TriangleMesh scene = build_scene("parking");
+  RelocalizeSettings settings;
+  settings.guess = pose(0.0, 0.0, 0.0, {500.0, 500.0, 0.0});
+  Relocalizer relocalizer(lane_map(scene, 0, eastbound(6.0, 58.0)), settings);
+  const std::vector<Eigen::Isometry3d> truth = eastbound(20.0, 40.0);
+  std::optional<Relocalization> placed;
+  for (size_t k = 0; k < truth.size() && !placed; ++k) {
+    placed = relocalizer.add_keyframe(static_cast<int64_t>(k) * 400'000'000,
+                                      truth.front().inverse() * truth[k], 2.0 * k,
+                                      scan_at(scene, truth[k], static_cast<uint32_t>(50 + k)));
+  }
+  ASSERT_TRUE(placed);
+  EXPECT_EQ(placed->found_by, "descriptor");
+  EXPECT_LT((placed->T_map_session.translation() - truth.front().translation()).norm(), 0.1);
+}
+
+TEST(SessionLinks, ALaterSessionPlacedOffIsPulledOntoTheFirst) {
+  const mesh::TriangleMesh scene = build_scene("parking");
+  std::vector<MapKeyframe> keyframes = lane_map(scene, 0, eastbound(6.0, 58.0));
+  const size_t first_later = keyframes.size();
+  // The second session, the other way round, placed 0.3 m and 0.5 degree off (as a match of
+  // its first keyframes may place it), its odometry drifting 1 cm sideways per metre.
+  const std::vector<Eigen::Isometry3d> truth = westbound(30.0, 6.0);
+  const Eigen::Isometry3d off = pose(0.5 * M_PI / 180.0, 0.0, 0.0, {0.2, -0.2, 0.05});
+  Eigen::Isometry3d estimate = truth.front() * off;
+  std::vector<MapKeyframe> later = lane_map(scene, 1, truth);
+  for (size_t k = 0; k < later.size(); ++k) {
+    if (k > 0)
+      estimate =
+          estimate * (truth[k - 1].inverse() * truth[k]) * pose(0.0, 0.0, 0.0, {0.0, 0.02, 0.0});
+    later[k].T_map_sensor = estimate;
+  }
+  for (MapKeyframe& k : later) keyframes.push_back(std::move(k));
+  const SessionLinkResult linked = link_sessions(keyframes, SessionLinkSettings{}, 1u);
+  EXPECT_GE(linked.links.size(), 3u);
+  EXPECT_TRUE(linked.unlinked_sessions.empty());
+  double worst_m = 0.0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    worst_m = std::max(
+        worst_m, (linked.poses[first_later + k].translation() - truth[k].translation()).norm());
+  }
+  EXPECT_LT(worst_m, 0.1);
+  // The first session, made consistent by its own loops, stays where it was, within what the
+  // two sessions' registrations tell apart.
+  for (size_t k = 0; k < first_later; ++k)
+    EXPECT_LT((linked.poses[k].translation() - keyframes[k].T_map_sensor.translation()).norm(),
+              0.05);
+}
+
+}  // namespace
+}  // namespace featsense::slam::loops
