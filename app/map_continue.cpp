@@ -134,6 +134,10 @@ void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& i
         slam::make_given_pose_locator(session.poses, config.odometry.deskew);
     PipelineSettings pipeline = replay;
     pipeline.range = {};
+    if (session.poses.size() > 0) {
+      pipeline.range.first_stamp_ns = session.poses.stamps_ns.front();
+      pipeline.range.last_stamp_ns = session.poses.stamps_ns.back();
+    }
     pipeline.total_frames = source->info().frames;
     const MapPassOutput pass = run_map_pass(
         *source, *locator, pipeline, config,

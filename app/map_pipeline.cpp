@@ -59,12 +59,14 @@ class PipelineState {
 
 bool before_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
   if (range.first_frame && scan.sequence < *range.first_frame) return true;
+  if (range.first_stamp_ns && scan.stamp_ns < *range.first_stamp_ns) return true;
   return range.first_s &&
          static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 < *range.first_s;
 }
 
 bool after_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
   if (range.last_frame && scan.sequence > *range.last_frame) return true;
+  if (range.last_stamp_ns && scan.stamp_ns > *range.last_stamp_ns) return true;
   return range.last_s && static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 > *range.last_s;
 }
 

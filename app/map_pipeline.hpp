@@ -33,6 +33,9 @@ struct FrameRange {
   std::optional<uint64_t> last_frame;
   std::optional<double> first_s;
   std::optional<double> last_s;
+  /// Stamps (the scans' clock): a session of a map mapped again keeps to its own scans.
+  std::optional<int64_t> first_stamp_ns;
+  std::optional<int64_t> last_stamp_ns;
 };
 
 /// A scan placed by the front end and turned into rays (app/scan_to_rays.hpp): what the

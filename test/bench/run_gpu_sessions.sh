@@ -14,6 +14,8 @@ f=/tmp/bundle/bin/featsense
 out=${OUT:-/tmp/out}
 mkdir -p "$out"
 root=$(pwd)
+# The map on the GPU where the bundle has it (BACKEND=cpu: the CPU backend, the same map).
+backend=${BACKEND:-cuda}
 nvidia-smi --query-gpu=name,memory.total --format=csv,noheader
 lscpu | grep "Model name"
 w=/tmp/sessions
@@ -39,9 +41,9 @@ if [ "${1:-continue}" = continue ]; then
   timed "simulate town loop" "$f" -q simulate --scene town --path loop -o A
   timed "simulate town drive" "$f" -q simulate --scene town --path drive -o B
   timed "simulate lab walk" "$f" -q simulate --scene lab --path walk --frames 300 -o L
-  timed "map loop (cuda)" "$f" -q map A -o MA --backend cuda
+  timed "map loop ($backend)" "$f" -q map A -o MA --backend "$backend"
   cp MA/report.json "$out/loop_report.json"
-  timed "continue with the drive (cuda)" "$f" -q map B --continue MA/map.h5 -o MB --backend cuda
+  timed "continue with the drive ($backend)" "$f" -q map B --continue MA/map.h5 -o MB --backend "$backend"
   cp MB/report.json "$out/drive_report.json"
   cp MB/trajectory.tum "$out/drive_trajectory.tum"
   python3 "$root/test/bench/pose_error.py" MB/trajectory.tum B/gt_trajectory.tum "drive placed, vs truth"
@@ -53,14 +55,14 @@ print('placed', l['placed'], 'at', l['seconds_in'], 's, keyframe', l['keyframe']
 print('mesh', json.dumps(m)[:600])
 print('sessions', [(s['id'], s['scans'], s['keyframes']) for s in r['sessions']])"
   sha256sum MB/map.h5 > "$out/before_lab.sha256"
-  "$f" -q map L --continue MB/map.h5 -o ML --backend cuda 2> "$out/lab_refused.txt"
+  "$f" -q map L --continue MB/map.h5 -o ML --backend "$backend" 2> "$out/lab_refused.txt"
   echo "lab into town: exit $?, $(tail -c 600 "$out/lab_refused.txt")"
   sha256sum -c "$out/before_lab.sha256"
 else
   rm -rf B2 MB2 MM.*
   mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done
-  timed "map the drive alone (cuda)" "$f" -q map B2 -o MB2 --backend cuda --no-mesh
-  timed "merge (cuda)" "$f" -q merge MA/map.h5 MB2/map.h5 -o MM.h5 --backend cuda
+  timed "map the drive alone ($backend)" "$f" -q map B2 -o MB2 --backend "$backend" --no-mesh
+  timed "merge ($backend)" "$f" -q merge MA/map.h5 MB2/map.h5 -o MM.h5 --backend "$backend"
   cp MM.report.json "$out/merge_report.json"
   python3 "$root/test/bench/pose_error.py" MM.session1.tum B/gt_trajectory.tum "drive merged, vs truth"
   python3 "$root/test/bench/pose_error.py" MM.session0.tum A/gt_trajectory.tum "loop merged, vs truth"

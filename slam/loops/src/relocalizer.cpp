@@ -15,6 +15,15 @@ namespace {
 /// is tens of metres away).
 constexpr double kDistinctPlacesM = 4.0;
 
+/// Earlier matches (the latest, at distinct places) whose place for the session is tried as a
+/// guess for the next keyframe.
+constexpr size_t kMatchGuesses = 2;
+
+/// Two verified places for one keyframe are ambiguous when the worse fit keeps this fraction
+/// of the better one's inliers: a block like another one fits as well; a registration that
+/// slid along a wall to a place nearby fits clearly worse.
+constexpr double kRivalInlierRatio = 0.85;
+
 bool near_any(const std::vector<size_t>& chosen, const std::vector<Eigen::Isometry3d>& poses,
               size_t candidate) {
   return std::any_of(chosen.begin(), chosen.end(), [&](size_t c) {
@@ -51,6 +60,26 @@ std::vector<Relocalizer::Candidate> Relocalizer::candidates(
       chosen.push_back(j);
       ++added;
     }
+  }
+  // Where an earlier keyframe's match puts this one (the latest few places, distinct): its
+  // descriptor may well pick a keyframe metres away in a place that looks alike all over.
+  size_t from_matches = 0;
+  for (auto h = hypotheses_.rbegin(); h != hypotheses_.rend() && from_matches < kMatchGuesses;
+       ++h) {
+    const Eigen::Isometry3d T_map_query = h->T_map_session * T_session_sensor;
+    size_t nearest = map_.size();
+    double best = settings_.loop.drift_base_m;
+    for (size_t j = 0; j < map_.size(); ++j) {
+      const double d = (map_poses_[j].translation() - T_map_query.translation()).norm();
+      if (d <= best) {
+        best = d;
+        nearest = j;
+      }
+    }
+    if (nearest == map_.size() || near_any(chosen, map_poses_, nearest)) continue;
+    out.push_back({nearest, map_poses_[nearest].inverse() * T_map_query, "earlier match", 1.0});
+    chosen.push_back(nearest);
+    ++from_matches;
   }
   // By descriptor: the nearest ring keys, then the full match with its yaw.
   if (descriptor.empty() || map_.empty()) return out;
@@ -159,19 +188,19 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
     done();
     return std::nullopt;
   }
-  for (size_t a = 0; a < verified.size(); ++a) {
-    for (size_t b = a + 1; b < verified.size(); ++b) {
-      if ((verified[a].T_map_query.translation() - verified[b].T_map_query.translation()).norm() >
-          loop.ambiguity_m) {
-        counts_.rejected["ambiguous"] += verified.size();
-        done();
-        return std::nullopt;
-      }
+  const Verified& best =
+      *std::max_element(verified.begin(), verified.end(), [](const Verified& a, const Verified& b) {
+        return a.result.inlier_fraction < b.result.inlier_fraction;
+      });
+  for (const Verified& rival : verified) {
+    if ((rival.T_map_query.translation() - best.T_map_query.translation()).norm() >
+            loop.ambiguity_m &&
+        rival.result.inlier_fraction >= kRivalInlierRatio * best.result.inlier_fraction) {
+      counts_.rejected["ambiguous"] += verified.size();
+      done();
+      return std::nullopt;
     }
   }
-  const Verified& best = *std::min_element(
-      verified.begin(), verified.end(),
-      [](const Verified& a, const Verified& b) { return a.result.fitness_m < b.result.fitness_m; });
   const Hypothesis hypothesis{keyframe, travelled_m, best.T_map_query * T_session_sensor.inverse()};
   size_t agreeing = 1;
   size_t disagreeing = 0;

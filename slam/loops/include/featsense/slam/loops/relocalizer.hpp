@@ -7,7 +7,10 @@
 /// places nothing. Each unambiguous match says where the session's frame lies in the map;
 /// the session is placed once `confirmations` keyframes agree on it (a single good-looking
 /// fit is a guess, and the map is never merged on a guess). A user's guess of the session's
-/// frame adds the map keyframes around it as candidates; it is verified like any other.
+/// frame adds the map keyframes around it as candidates; it is verified like any other. A
+/// match also guesses where the next keyframes lie: each is tried there too, so that a place
+/// that looks alike all over (a room, a corridor) is confirmed where the registration from the
+/// descriptor alone would slide.
 /// Not thread-safe: one caller, keyframes in order.
 
 #include <Eigen/Geometry>
@@ -57,7 +60,7 @@ struct Relocalization {
   size_t keyframe = 0;      ///< the new session's keyframe (count, from 0) that confirmed it
   size_t map_keyframe = 0;  ///< the map keyframe it matched (index into the map's keyframes)
   int64_t stamp_ns = 0;
-  std::string found_by;  ///< "descriptor" or "guess"
+  std::string found_by;  ///< "descriptor", "guess" or "earlier match"
   double descriptor_distance = 1.0;
   double fitness_m = 0.0;
   double inlier_fraction = 0.0;
