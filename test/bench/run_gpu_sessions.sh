@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # On the GPU machine, from the repository root, with .device/bundle.tar.xz carried along: one
-# map from several recordings. `continue` (default): the town loop mapped, then the town drive
-# (starts 50 m away, turned 90 deg, another path) continued into it without poses: where it was
-# placed against its truth, the merged map's mesh against the true surface; then the lab
-# continued into that map (must be refused, the map byte-identical). `merge` (after
-# `continue`, same warm machine): the drive mapped alone in its own frame, then merged into
-# the loop's map, and the same figures. Results go to $OUT.
-# Usage: bash test/bench/run_gpu_sessions.sh [continue|merge]
+# map from several recordings, in three calls on the same warm machine. `loop`: simulates the
+# town loop, the town drive and the lab, and maps the loop. `continue`: the drive (starts
+# 50 m away, turned 90 deg, another path) continued into the loop's map without poses: where
+# it was placed against its truth, the joined map's mesh against the true surface; then the
+# lab continued into that map (must be refused, the map byte-identical). `merge`: the drive
+# mapped alone in its own frame, then merged into the loop's map, and the same figures.
+# BACKEND=cpu maps with the CPU backend (the same map). Results go to $OUT.
+# Usage: bash test/bench/run_gpu_sessions.sh loop|continue|merge
 set -uo pipefail
 tar xJf .device/bundle.tar.xz -C /tmp
 export LD_LIBRARY_PATH=/tmp/bundle/lib
@@ -36,13 +37,17 @@ import json, sys
 d = json.load(open(sys.argv[1])); a = d.get('accuracy', d)
 print(sys.argv[2], 'mesh vs truth:', json.dumps(a)[:400])" "$out/eval_$1.json" "$1"
 }
-if [ "${1:-continue}" = continue ]; then
+what=${1:-loop}
+if [ "$what" = loop ]; then
   rm -rf A B L MA MB ML
   timed "simulate town loop" "$f" -q simulate --scene town --path loop -o A
   timed "simulate town drive" "$f" -q simulate --scene town --path drive -o B
   timed "simulate lab walk" "$f" -q simulate --scene lab --path walk --frames 300 -o L
   timed "map loop ($backend)" "$f" -q map A -o MA --backend "$backend"
   cp MA/report.json "$out/loop_report.json"
+  python3 "$root/test/bench/pose_error.py" MA/trajectory.tum A/gt_trajectory.tum "loop vs truth"
+elif [ "$what" = continue ]; then
+  rm -rf MB ML
   timed "continue with the drive ($backend)" "$f" -q map B --continue MA/map.h5 -o MB --backend "$backend"
   cp MB/report.json "$out/drive_report.json"
   cp MB/trajectory.tum "$out/drive_trajectory.tum"
