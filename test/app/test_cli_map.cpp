@@ -17,6 +17,7 @@
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
+#include "common/spawn_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
@@ -374,29 +375,6 @@ TEST_F(CliMap, BadInputGivesOneClearError) {
                     kSmallMap + " --start ten");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--start: expected a frame index"), std::string::npos) << r.output;
-}
-
-/// Starts `featsense ARGS` as a child process; returns its pid.
-pid_t spawn_featsense(const std::string& args, const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const std::string command =
-        "exec " + featsense_program() + " " + args + " >" + log.string() + " 2>&1 </dev/null";
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  return pid;
-}
-
-/// Waits until the store's journal holds a flushed chunk (or the child ended).
-bool wait_for_first_flush(const fs::path& journal, pid_t child) {
-  for (int i = 0; i < 600; ++i) {
-    if (fs::exists(journal) && fs::file_size(journal) > 4096) return true;
-    int status = 0;
-    if (waitpid(child, &status, WNOHANG) == child) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return false;
 }
 
 /// Frames of the sequence the runs stopped by a signal map: so many that the run is still

@@ -3,6 +3,8 @@
 // recording of another place is refused with the map left as it was, and `featsense merge`.
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +18,7 @@
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
+#include "common/spawn_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
@@ -227,6 +230,43 @@ TEST_F(CliMapSessions, MergeJoinsTwoMapsMadeApart) {
   storage::Hdf5ChunkStore store(dir / "c.h5");
   EXPECT_EQ(store.read_trajectory().size(), 24u);
   EXPECT_GT(store.keys().size(), 0u);
+}
+
+TEST_F(CliMapSessions, KillNineDuringAContinuedRunLeavesTheMapReadable) {
+  // A recording long enough that its mapping pass is still running at its first flush, the
+  // map continued in its own folder.
+  const fs::path dir = scratch_dir("cli_map_sessions_kill");
+  const fs::path sequence = dir / "lab";
+  CommandResult run =
+      run_featsense("simulate --quiet --scene lab --frames 72 -o " + sequence.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const fs::path out = dir / "map";
+  run = run_featsense("map " + sequence.string() + " --end 23 -o " + out.string() + kSmall);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::vector<storage::ChunkKey> before;
+  {
+    storage::Hdf5ChunkStore old_map(out / "map.h5");
+    before = old_map.keys();
+  }
+  const pid_t child = spawn_featsense("map " + sequence.string() + " --start 24 --continue " +
+                                          (out / "map.h5").string() + " -o " + out.string() +
+                                          kSmall + " --set map.flush_interval=1",
+                                      dir / "continue.log");
+  // The recording is placed first (nothing written), then mapped into the map.
+  ASSERT_TRUE(wait_for_first_flush(out / "map.h5.journal", child, std::chrono::seconds(300)))
+      << "the run ended before its first flush";
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  storage::Hdf5ChunkStore store(out / "map.h5");  // replays the journal
+  for (const storage::ChunkKey& key : before) EXPECT_TRUE(store.read(key).has_value());
+  for (const storage::ChunkKey& key : store.keys()) ASSERT_TRUE(store.read(key).has_value());
+  EXPECT_GE(store.keys().size(), before.size());
+  ASSERT_GE(store.read_sessions().size(), 1u);
+  EXPECT_EQ(store.read_sessions()[0].scans, 24u);
+  EXPECT_GT(store.read_keyframes().size(), 0u);
+  fs::remove_all(sequence);
 }
 
 }  // namespace
