@@ -6,7 +6,7 @@
 # it was placed against its truth, the joined map's mesh against the true surface; then the
 # lab continued into that map (must be refused, the map byte-identical). `merge`: the drive
 # mapped alone in its own frame, then merged into the loop's map, and the same figures.
-# BACKEND=cpu maps with the CPU backend (the same map). Results go to $OUT.
+# BACKEND=cpu maps with the CPU backend (the same map); EXTRA adds settings. Results go to $OUT.
 # Usage: bash test/bench/run_gpu_sessions.sh loop|continue|merge
 set -uo pipefail
 tar xJf .device/bundle.tar.xz -C /tmp
@@ -17,6 +17,8 @@ mkdir -p "$out"
 root=$(pwd)
 # The map on the GPU where the bundle has it (BACKEND=cpu: the CPU backend, the same map).
 backend=${BACKEND:-cuda}
+# More settings for every map and merge, e.g. EXTRA="--set map.carve_free_space=false".
+extra=${EXTRA:-}
 nvidia-smi --query-gpu=name,memory.total --format=csv,noheader
 lscpu | grep "Model name"
 w=/tmp/sessions
@@ -34,8 +36,9 @@ mesh_figures() {  # label, mesh
   "$f" -q eval mesh "$2" A/gt_mesh.ply --json "$out/eval_$1.json" > /dev/null &&
     python3 -c "
 import json, sys
-d = json.load(open(sys.argv[1])); a = d.get('accuracy', d)
-print(sys.argv[2], 'mesh vs truth:', json.dumps(a)[:400])" "$out/eval_$1.json" "$1"
+d = json.load(open(sys.argv[1])); a = d['accuracy']
+print(sys.argv[2], 'mesh vs truth: mean %.4f median %.4f p95 %.4f m (p95/mean %.2f), completeness %s' % (
+      a['mean_abs'], a['median'], a['p95'], a['p95'] / a['mean_abs'], json.dumps(d['completeness'])))" "$out/eval_$1.json" "$1"
 }
 what=${1:-loop}
 if [ "$what" = loop ]; then
@@ -43,12 +46,12 @@ if [ "$what" = loop ]; then
   timed "simulate town loop" "$f" -q simulate --scene town --path loop -o A
   timed "simulate town drive" "$f" -q simulate --scene town --path drive -o B
   timed "simulate lab walk" "$f" -q simulate --scene lab --path walk --frames 300 -o L
-  timed "map loop ($backend)" "$f" -q map A -o MA --backend "$backend"
+  timed "map loop ($backend)" "$f" -q map A -o MA --backend "$backend" $extra --no-mesh
   cp MA/report.json "$out/loop_report.json"
   python3 "$root/test/bench/pose_error.py" MA/trajectory.tum A/gt_trajectory.tum "loop vs truth"
 elif [ "$what" = continue ]; then
   rm -rf MB ML
-  timed "continue with the drive ($backend)" "$f" -q map B --continue MA/map.h5 -o MB --backend "$backend"
+  timed "continue with the drive ($backend)" "$f" -q map B --continue MA/map.h5 -o MB --backend "$backend" $extra
   cp MB/report.json "$out/drive_report.json"
   cp MB/trajectory.tum "$out/drive_trajectory.tum"
   python3 "$root/test/bench/pose_error.py" MB/trajectory.tum B/gt_trajectory.tum "drive placed, vs truth"
@@ -57,21 +60,23 @@ import json
 r = json.load(open('MB/report.json')); l = r['relocalization']; m = r.get('eval', {}).get('mesh', {})
 print('placed', l['placed'], 'at', l['seconds_in'], 's, keyframe', l['keyframe'], 'fitness', l['fitness_m'],
       'agreeing', l['agreeing'], 'links', l['links']['count'], 'earlier sessions', json.dumps(l['earlier_sessions']))
-print('mesh', json.dumps(m)[:600])
+a = m.get('accuracy', {})
+if a: print('mesh vs truth as mapped: mean %.4f median %.4f p95 %.4f m (p95/mean %.2f)' % (
+      a['mean_abs'], a['median'], a['p95'], a['p95'] / a['mean_abs']), 'completeness', json.dumps(m.get('completeness')))
+else: print('mesh', json.dumps(m)[:600])
 print('sessions', [(s['id'], s['scans'], s['keyframes']) for s in r['sessions']])"
   sha256sum MB/map.h5 > "$out/before_lab.sha256"
-  "$f" -q map L --continue MB/map.h5 -o ML --backend "$backend" 2> "$out/lab_refused.txt"
+  "$f" -q map L --continue MB/map.h5 -o ML --backend "$backend" $extra 2> "$out/lab_refused.txt"
   echo "lab into town: exit $?, $(tail -c 600 "$out/lab_refused.txt")"
   sha256sum -c "$out/before_lab.sha256"
 else
   rm -rf B2 MB2 MM.*
   mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done
-  timed "map the drive alone ($backend)" "$f" -q map B2 -o MB2 --backend "$backend" --no-mesh
-  timed "merge ($backend)" "$f" -q merge MA/map.h5 MB2/map.h5 -o MM.h5 --backend "$backend"
+  timed "map the drive alone ($backend)" "$f" -q map B2 -o MB2 --backend "$backend" $extra --no-mesh
+  timed "merge ($backend)" "$f" -q merge MA/map.h5 MB2/map.h5 -o MM.h5 --backend "$backend" $extra
   cp MM.report.json "$out/merge_report.json"
   python3 "$root/test/bench/pose_error.py" MM.session1.tum B/gt_trajectory.tum "drive merged, vs truth"
   python3 "$root/test/bench/pose_error.py" MM.session0.tum A/gt_trajectory.tum "loop merged, vs truth"
   timed "mesh merged" "$f" -q mesh MM.h5 -o MM.ply
   mesh_figures merged MM.ply
-  mesh_figures continued MB/mesh.ply
 fi
