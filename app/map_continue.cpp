@@ -326,6 +326,13 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
         1000.0 * moved_m, not_again);
   }
 
+  if (!pipeline.integrate) {
+    // --poses-only: placed, and nothing written into any map.
+    run.pass.result = run.first;
+    run.pass.result.poses = run.final_poses;
+    run.second_pass = "--poses-only: placed, no map";
+    return run;
+  }
   // The mapping pass(es): this recording with its final poses, deskewed as the odometry
   // placed each scan; before it, where they moved, every earlier session again.
   PipelineSettings replay = pipeline;

@@ -183,6 +183,15 @@ TEST_F(CliMapSessions, ARecordingOfAnotherPlaceIsRefusedAndTheMapStaysAsItWas) {
   const nlohmann::json report = read_json(dir / "lab" / "report.json");
   EXPECT_FALSE(report["relocalization"]["placed"].get<bool>()) << report.dump(2);
 
+  // The poses alone: the lab's own recording placed, the map untouched.
+  run = run_featsense("map " + lab() + " --start 12 --continue " + map.string() + " -o " +
+                      (dir / "poses").string() + kSmall + " --poses-only");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(read_json(dir / "poses" / "report.json")["relocalization"]["placed"].get<bool>());
+  EXPECT_TRUE(fs::exists(dir / "poses" / "trajectory.tum"));
+  EXPECT_FALSE(fs::exists(dir / "poses" / "map.h5"));
+  EXPECT_TRUE(file_bytes(map) == before) << "the map changed";
+
   // A map made with given poses keeps no keyframes: it is continued with poses.
   run = run_featsense("map " + lab() + " --end 5 --gt " + lab() + "/gt_trajectory.tum -o " +
                       (dir / "given").string() + kSmall);
