@@ -245,6 +245,10 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
     report["why"] = why.str();
     throw RelocalizationFailed(why.str(), report);
   }
+  if (run.first.interrupted) {
+    throw Interrupted("interrupted after " + request.session.input + " was placed in " +
+                      request.old_map.string() + ", before it was mapped: the map is unchanged");
+  }
   const slam::loops::Relocalization& placement = *loops.relocalization;
   uint32_t session_id = 0;
   for (const SavedSession& s : saved.sessions) session_id = std::max(session_id, s.session.id + 1);
