@@ -39,6 +39,14 @@ const char* to_string(LoopRejection reason) {
   return "?";
 }
 
+std::optional<LoopRejection> fit_rejection(const refine::VgicpResult& result,
+                                           const LoopSettings& settings) {
+  if (!result.converged) return LoopRejection::not_converged;
+  if (result.fitness_m > settings.max_fitness_m) return LoopRejection::fitness;
+  if (result.inlier_fraction < settings.min_inlier_fraction) return LoopRejection::inliers;
+  return std::nullopt;
+}
+
 LoopCloser::LoopCloser(const LoopSettings& settings) : settings_(settings) {}
 
 KeyframeSelector::KeyframeSelector(double distance_m, double angle_deg)
@@ -146,19 +154,14 @@ std::vector<LoopCloser::Candidate> LoopCloser::find_candidates(size_t query) con
   const size_t keep = std::min(settings_.descriptor_candidates, by_ring.size());
   std::partial_sort(by_ring.begin(), by_ring.begin() + static_cast<std::ptrdiff_t>(keep),
                     by_ring.end());
-  const Eigen::Matrix3d L_query = levelling(q.T_front_end);
   std::vector<Candidate> by_descriptor;
   for (size_t k = 0; k < keep; ++k) {
     const size_t j = by_ring[k].second;
     const ScanContextMatch m = match(q.descriptor, keyframes_[j].descriptor);
     if (m.distance > settings_.max_descriptor_distance) continue;
-    // Turned by the descriptor's yaw between the two levelled frames, no translation: the
-    // descriptor says "the same place".
-    Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
-    guess.linear() = levelling(keyframes_[j].T_front_end).transpose() *
-                     Eigen::AngleAxisd(m.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                     L_query;
-    by_descriptor.push_back({j, guess, "descriptor", m.distance});
+    by_descriptor.push_back({j,
+                             descriptor_guess(keyframes_[j].T_front_end, q.T_front_end, m.yaw_rad),
+                             "descriptor", m.distance});
   }
   std::sort(by_descriptor.begin(), by_descriptor.end(), [](const Candidate& a, const Candidate& b) {
     return a.descriptor_distance < b.descriptor_distance;
@@ -235,11 +238,7 @@ bool LoopCloser::add_keyframe(int64_t stamp_ns, double travelled_m,
   keyframe.stamp_ns = stamp_ns;
   keyframe.travelled_m = travelled_m;
   keyframe.T_front_end = T_map_sensor;
-  const Eigen::Matrix3f L = levelling(T_map_sensor).cast<float>();
-  std::vector<Eigen::Vector3f> levelled;
-  levelled.reserve(points.size());
-  for (const Eigen::Vector3f& p : points) levelled.push_back(L * p);
-  keyframe.descriptor = make_scan_context(levelled, settings_.scan_context);
+  keyframe.descriptor = levelled_scan_context(T_map_sensor, points, settings_.scan_context);
   keyframe.cloud = CompactCloud(points);
   counts_.cloud_bytes += keyframe.cloud.bytes();
   const refine::GaussianCloud cloud =
@@ -275,16 +274,8 @@ bool LoopCloser::add_keyframe(int64_t stamp_ns, double travelled_m,
     const refine::GaussianCloud target = target_around(candidate.keyframe);
     const refine::VgicpResult result =
         refine::align(target, cloud, candidate.guess, settings_.vgicp);
-    if (!result.converged) {
-      reject(LoopRejection::not_converged);
-      continue;
-    }
-    if (result.fitness_m > settings_.max_fitness_m) {
-      reject(LoopRejection::fitness);
-      continue;
-    }
-    if (result.inlier_fraction < settings_.min_inlier_fraction) {
-      reject(LoopRejection::inliers);
+    if (const std::optional<LoopRejection> failed = fit_rejection(result, settings_)) {
+      reject(*failed);
       continue;
     }
     ++counts_.verified;

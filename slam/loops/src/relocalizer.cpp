@@ -102,17 +102,12 @@ std::vector<Relocalizer::Candidate> Relocalizer::candidates(
   }
   std::sort(matches.begin(), matches.end(),
             [](const auto& a, const auto& b) { return a.first.distance < b.first.distance; });
-  const Eigen::Matrix3d L_query = levelling(T_session_sensor);
   size_t added = 0;
   for (const auto& [m, j] : matches) {
     if (added == settings_.verifications) break;
     if (near_any(chosen, map_poses_, j)) continue;
-    // Turned by the descriptor's yaw between the two levelled frames, no translation.
-    Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
-    guess.linear() = levelling(map_poses_[j]).transpose() *
-                     Eigen::AngleAxisd(m.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                     L_query;
-    out.push_back({j, guess, "descriptor", m.distance});
+    out.push_back({j, descriptor_guess(map_poses_[j], T_session_sensor, m.yaw_rad), "descriptor",
+                   m.distance});
     chosen.push_back(j);
     ++added;
   }
@@ -140,13 +135,9 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
             .count());
   };
   const LoopSettings& loop = settings_.loop;
-  const Eigen::Matrix3f L = levelling(T_session_sensor).cast<float>();
   // The points as the map keeps its keyframes' (centimetres), so both sides are alike.
   const std::vector<Eigen::Vector3f> kept = CompactCloud(points).points();
-  std::vector<Eigen::Vector3f> levelled;
-  levelled.reserve(kept.size());
-  for (const Eigen::Vector3f& p : kept) levelled.push_back(L * p);
-  const ScanContext descriptor = make_scan_context(levelled, loop.scan_context);
+  const ScanContext descriptor = levelled_scan_context(T_session_sensor, kept, loop.scan_context);
   const std::vector<Candidate> found = candidates(descriptor, T_session_sensor);
   counts_.candidates += found.size();
   if (found.empty()) {
@@ -165,12 +156,8 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
     const refine::GaussianCloud target = keyframe_target(map_, map_poses_, candidate.map_keyframe,
                                                          loop.target_neighbours, loop.neighbours);
     const refine::VgicpResult result = refine::align(target, cloud, candidate.guess, loop.vgicp);
-    if (!result.converged) {
-      reject("not converged");
-    } else if (result.fitness_m > loop.max_fitness_m) {
-      reject("fitness");
-    } else if (result.inlier_fraction < loop.min_inlier_fraction) {
-      reject("inliers");
+    if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
+      reject(to_string(*failed));
     } else {
       const Eigen::Isometry3d T_map_query =
           map_poses_[candidate.map_keyframe] * result.T_target_source;

@@ -94,6 +94,25 @@ Eigen::Matrix3d levelling(const Eigen::Isometry3d& T_map_sensor) {
   return Eigen::AngleAxisd(-heading, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R;
 }
 
+ScanContext levelled_scan_context(const Eigen::Isometry3d& T_map_sensor,
+                                  const std::vector<Eigen::Vector3f>& points,
+                                  const ScanContextSettings& settings) {
+  const Eigen::Matrix3f L = levelling(T_map_sensor).cast<float>();
+  std::vector<Eigen::Vector3f> levelled;
+  levelled.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) levelled.push_back(L * p);
+  return make_scan_context(levelled, settings);
+}
+
+Eigen::Isometry3d descriptor_guess(const Eigen::Isometry3d& T_map_candidate,
+                                   const Eigen::Isometry3d& T_map_query, double yaw_rad) {
+  Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+  guess.linear() = levelling(T_map_candidate).transpose() *
+                   Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                   levelling(T_map_query);
+  return guess;
+}
+
 ScanContextMatch match(const ScanContext& query, const ScanContext& candidate) {
   if (query.rings != candidate.rings || query.sectors != candidate.sectors || query.empty())
     throw std::invalid_argument("scan context: descriptors of different sizes");

@@ -96,23 +96,15 @@ SessionLinkResult link_sessions(const std::vector<MapKeyframe>& keyframes,
             keyframe_target(keyframes, poses, j, loop.target_neighbours, loop.neighbours);
         const refine::VgicpResult result =
             refine::align(target, cloud, poses[j].inverse() * poses[i], loop.vgicp);
-        if (!result.converged) {
-          reject("not converged");
-          continue;
-        }
-        if (result.fitness_m > loop.max_fitness_m) {
-          reject("fitness");
-          continue;
-        }
-        if (result.inlier_fraction < loop.min_inlier_fraction) {
-          reject("inliers");
+        if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
+          reject(to_string(*failed));
           continue;
         }
         const Eigen::Isometry3d T_map_query = poses[j] * result.T_target_source;
         if ((T_map_query.translation() - poses[i].translation()).norm() > radius_m ||
             rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation()) >
                 radius_deg) {
-          reject("inconsistent with the odometry");
+          reject(to_string(LoopRejection::inconsistent));
           continue;
         }
         PoseGraphEdge edge;

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -114,6 +115,11 @@ class KeyframeSelector {
 /// Why a candidate did not become a loop.
 enum class LoopRejection { not_converged, fitness, inliers, inconsistent, ambiguous };
 const char* to_string(LoopRejection reason);
+
+/// Why a registration of a revisit fails the fit (not converged, fitness, inliers): none
+/// where it passes. The checks of loops, relocalization and links between sessions.
+std::optional<LoopRejection> fit_rejection(const refine::VgicpResult& result,
+                                           const LoopSettings& settings);
 
 /// An accepted loop: keyframe `query` revisits keyframe `candidate`.
 struct LoopRecord {

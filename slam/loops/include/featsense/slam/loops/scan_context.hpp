@@ -62,6 +62,18 @@ struct ScanContextMatch {
 /// sector columns that hold points in either, at the best column shift.
 ScanContextMatch match(const ScanContext& query, const ScanContext& candidate);
 
+/// The descriptor of `points` (sensor frame) taken by a sensor at `T_map_sensor`: turned into
+/// its levelled frame first.
+ScanContext levelled_scan_context(const Eigen::Isometry3d& T_map_sensor,
+                                  const std::vector<Eigen::Vector3f>& points,
+                                  const ScanContextSettings& settings);
+
+/// The pose of the query's sensor in the candidate's (candidate <- query) that a match says:
+/// turned by the match's yaw between the two levelled frames, no translation ("the same
+/// place"), from the two sensors' poses in their own maps.
+Eigen::Isometry3d descriptor_guess(const Eigen::Isometry3d& T_map_candidate,
+                                   const Eigen::Isometry3d& T_map_query, double yaw_rad);
+
 /// The L2 distance of the ring keys.
 double ring_key_distance(const ScanContext& a, const ScanContext& b);
 
