@@ -51,26 +51,6 @@ SavedMap read_map_to_merge(const std::string& path, const config::Config& config
   return saved;
 }
 
-/// `keyframes` of `from` [first, end) as SessionRemaps, their poses moved by `poses`.
-void add_remaps(const SavedMap& from, const std::vector<MapKeyframe>& keyframes, size_t first,
-                uint32_t id_offset, const Eigen::Isometry3d& T_into_from,
-                const std::vector<Eigen::Isometry3d>& poses, const std::string& note,
-                std::vector<SessionRemap>& out) {
-  for (const SavedSession& session : from.sessions) {
-    size_t end = first;
-    while (end < keyframes.size() && keyframes[end].session == session.session.id + id_offset)
-      ++end;
-    slam::Trajectory placed;
-    for (size_t i = 0; i < session.poses.size(); ++i)
-      placed.push_back(session.poses.stamps_ns[i], T_into_from * session.poses.poses[i]);
-    out.push_back(
-        {{session.session.input, session.session.format, session.session.placement + note},
-         moved_path(placed, keyframes, first, end, poses),
-         records_of(keyframes, first, end, poses)});
-    first = end;
-  }
-}
-
 void run_merge(const MergeOptions& options, const CliContext& context) {
   std::vector<config::Override> overrides;
   add_config_override(overrides, kBackendOption, options.backend);
@@ -142,28 +122,21 @@ void run_merge(const MergeOptions& options, const CliContext& context) {
                      {"rejected", linked.rejected},
                      {"unlinked_sessions", linked.unlinked_sessions}};
 
-  std::vector<SessionRemap> sessions;
-  add_remaps(first, keyframes, 0, 0, Eigen::Isometry3d::Identity(), linked.poses,
-             "; merged with " + options.second, sessions);
-  add_remaps(second, keyframes, first_second, offset, placement.T_map_session, linked.poses,
-             "; merged into " + options.first + " (relocalized)", sessions);
+  std::vector<SessionRemap> sessions =
+      session_remaps(first, keyframes, 0, 0, Eigen::Isometry3d::Identity(), linked.poses,
+                     "; merged with " + options.second);
+  for (SessionRemap& remap :
+       session_remaps(second, keyframes, first_second, offset, placement.T_map_session,
+                      linked.poses, "; merged into " + options.first + " (relocalized)"))
+    sessions.push_back(std::move(remap));
   PipelineSettings replay;
   replay.flush_interval_s = config.map.flush_interval_s;
   replay.quiet = context.quiet;
   replay.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
   const fs::path partial = fs::path(options.output + ".partial");
-  try {
+  build_then_replace(partial, output, [&] {
     remap_sessions(sessions, partial, replay, config, first.metadata.sensor);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(partial, ignored);
-    fs::remove(fs::path(partial.string() + ".journal"), ignored);
-    throw;
-  }
-  fs::rename(partial, output);
-  // Closed cleanly, its journal holds nothing the file does not.
-  std::error_code ignored;
-  fs::remove(fs::path(partial.string() + ".journal"), ignored);
+  });
   // Each session's poses in the merged map, beside it: C.session0.tum, ...
   for (size_t k = 0; k < sessions.size(); ++k) {
     slam::write_tum(

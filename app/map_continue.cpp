@@ -121,6 +121,25 @@ std::vector<slam::loops::KeyframeRecord> records_of(const std::vector<MapKeyfram
   return out;
 }
 
+std::vector<SessionRemap> session_remaps(const SavedMap& saved,
+                                         const std::vector<MapKeyframe>& keyframes, size_t first,
+                                         uint32_t id_offset, const Eigen::Isometry3d& T_into_saved,
+                                         const std::vector<Eigen::Isometry3d>& poses,
+                                         const std::string& note) {
+  std::vector<SessionRemap> out;
+  for (const SavedSession& session : saved.sessions) {
+    size_t end = first;
+    while (end < keyframes.size() && keyframes[end].session == session.session.id + id_offset)
+      ++end;
+    out.push_back(
+        {{session.session.input, session.session.format, session.session.placement + note},
+         moved_path(moved_by(T_into_saved, session.poses), keyframes, first, end, poses),
+         records_of(keyframes, first, end, poses)});
+    first = end;
+  }
+  return out;
+}
+
 void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
                     const PipelineSettings& replay, config::Config& config,
                     const std::string& sensor_name) {
@@ -362,39 +381,20 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
     run.second_pass = "mapped into the saved map with the placed, corrected poses";
     return run;
   }
-  const fs::path rebuilt = request.out / "map.rebuilt.h5";
-  std::error_code ignored;
-  fs::remove(rebuilt, ignored);
-  fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
   try {
-    std::vector<SessionRemap> earlier;
-    size_t first = 0;
-    for (const SavedSession& old : saved.sessions) {
-      size_t end = first;
-      while (end < first_new && keyframes[end].session == old.session.id) ++end;
-      earlier.push_back({{old.session.input, old.session.format,
-                          old.session.placement + "; moved by the links of session " +
-                              std::to_string(session_id)},
-                         moved_path(old.poses, keyframes, first, end, linked.poses),
-                         records_of(keyframes, first, end, linked.poses)});
-      first = end;
-    }
-    remap_sessions(earlier, rebuilt, replay, config, request.sensor_name);
-    run.pass = this_recording(rebuilt, rebuilt.string(), true);
-    if (run.pass.result.interrupted) throw Interrupted("interrupted");
+    build_then_replace(request.out / "map.rebuilt.h5", map_out, [&] {
+      const fs::path rebuilt = request.out / "map.rebuilt.h5";
+      remap_sessions(
+          session_remaps(saved, keyframes, 0, 0, Eigen::Isometry3d::Identity(), linked.poses,
+                         "; moved by the links of session " + std::to_string(session_id)),
+          rebuilt, replay, config, request.sensor_name);
+      run.pass = this_recording(rebuilt, rebuilt.string(), true);
+      if (run.pass.result.interrupted) throw Interrupted("interrupted");
+    });
   } catch (const Interrupted&) {
-    fs::remove(rebuilt, ignored);
-    fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
     throw Interrupted("interrupted while the map was made again; " + request.old_map.string() +
                       " is unchanged");
-  } catch (...) {
-    fs::remove(rebuilt, ignored);
-    fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
-    throw;
   }
-  fs::rename(rebuilt, map_out);
-  // Closed cleanly, its journal holds nothing the file does not.
-  fs::remove(fs::path(rebuilt.string() + ".journal"), ignored);
   run.second_pass = "every session mapped again with the corrected poses";
   return run;
 }

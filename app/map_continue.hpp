@@ -47,28 +47,6 @@ struct ContinueRequest {
   std::string sensor_name;
   bool overwrite = false;
   SessionDescription session;
-  /// Why the sessions of `saved` cannot be mapped again from their inputs (empty: they can).
-  std::string why_sessions_cannot_be_read(const SavedMap& saved, const config::Config& config);
-
-  /// Keyframes [first, end) as a map file records them, at `poses` (same indexing).
-  std::vector<slam::loops::KeyframeRecord> records_of(
-      const std::vector<slam::loops::MapKeyframe>& keyframes, size_t first, size_t end,
-      const std::vector<Eigen::Isometry3d>& poses);
-
-  /// A session to be mapped again: its input and how it was placed, its final poses and
-  /// keyframes.
-  struct SessionRemap {
-    SessionDescription description;
-    slam::Trajectory poses;
-    std::vector<slam::loops::KeyframeRecord> keyframes;
-  };
-
-  /// Maps each session again from its input with its poses (interpolated within each sweep),
-  /// in order, into `into` (replaced). Throws Interrupted, InputError or std::runtime_error.
-  void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
-                      const PipelineSettings& replay, config::Config& config,
-                      const std::string& sensor_name);
-
   /// --initial-pose: where the recording's first scan lies in the map, roughly.
   std::optional<Eigen::Isometry3d> guess;
 };
@@ -104,6 +82,17 @@ struct SessionRemap {
   slam::Trajectory poses;
   std::vector<slam::loops::KeyframeRecord> keyframes;
 };
+
+/// The sessions of `saved` to be mapped again: each one's poses taken into the new map's frame
+/// by `T_into_saved`, then moved as its keyframes moved (its keyframes are the run of
+/// `keyframes` from `first` whose session is its id + `id_offset`; `poses` their poses after),
+/// its placement text followed by `note`.
+std::vector<SessionRemap> session_remaps(const SavedMap& saved,
+                                         const std::vector<slam::loops::MapKeyframe>& keyframes,
+                                         size_t first, uint32_t id_offset,
+                                         const Eigen::Isometry3d& T_into_saved,
+                                         const std::vector<Eigen::Isometry3d>& poses,
+                                         const std::string& note);
 
 /// Maps each session again from its input with its poses (interpolated within each sweep),
 /// in order, into `into` (replaced). Throws Interrupted, InputError or std::runtime_error.

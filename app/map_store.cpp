@@ -79,6 +79,27 @@ void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& 
   adopt("map.truncation", config.map.truncation_m, old_map.truncation_m);
 }
 
+void build_then_replace(const fs::path& partial, const fs::path& target,
+                        const std::function<void()>& build) {
+  const fs::path journal = partial.string() + ".journal";
+  const auto remove_partial = [&] {
+    std::error_code ignored;
+    fs::remove(partial, ignored);
+    fs::remove(journal, ignored);
+  };
+  remove_partial();  // a run killed earlier may have left one
+  try {
+    build();
+  } catch (...) {
+    remove_partial();
+    throw;
+  }
+  fs::rename(partial, target);
+  // Closed cleanly, its journal holds nothing the file does not.
+  std::error_code ignored;
+  fs::remove(journal, ignored);
+}
+
 std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory) {
   std::vector<storage::TrajectoryPose> poses;
   for (size_t i = 0; i < trajectory.size(); ++i) {

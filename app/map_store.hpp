@@ -3,6 +3,7 @@
 // map (.h5 or .vdb), whose voxel size and tau then win over the configuration.
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,6 +37,12 @@ void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& 
 
 /// The trajectory of a store's poses.
 slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses);
+
+/// Runs `build`, which writes the map file `partial`, and renames it over `target` once
+/// `build` returns: a map is replaced only by a complete one. Where `build` throws, `partial`
+/// (and its journal) is removed and the exception passes on.
+void build_then_replace(const std::filesystem::path& partial, const std::filesystem::path& target,
+                        const std::function<void()>& build);
 
 /// The store's trajectory form of `trajectory`.
 std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory);
