@@ -17,6 +17,7 @@
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
+#include "common/small_map_options.hpp"
 #include "common/spawn_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
@@ -25,11 +26,6 @@ namespace featsense::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A small, coarse map keeps each run to seconds on two cores.
-const std::string kSmallMap =
-    " --quiet --backend cpu --set map.size=[16,16,8] --set map.voxel_size=0.1"
-    " --set map.truncation=0.3 --set map.shift_threshold=1.0";
 
 class CliMap : public ::testing::Test {
  public:

@@ -18,6 +18,7 @@
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
+#include "common/small_map_options.hpp"
 #include "common/spawn_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
@@ -27,11 +28,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A small, coarse map keeps each run to seconds on two cores; keyframes every 0.3 m give a
-// walk of a metre a few of them.
-const std::string kSmall =
-    " --quiet --backend cpu --no-mesh --set map.size=[16,16,8] --set map.voxel_size=0.1"
-    " --set map.truncation=0.3 --set map.shift_threshold=1.0 --set loop.keyframe_distance=0.3";
+// Keyframes every 0.3 m give a walk of a metre a few of them.
+const std::string kSmall = kSmallMap + " --no-mesh --set loop.keyframe_distance=0.3";
 
 // Scans placed rigidly at their stamps: a deskewed scan of a continued run is moved within its
 // sweep as the odometry placed it, which its pose alone does not say; without deskewing, the

@@ -3,6 +3,7 @@
 // samplings of one place never share a point.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cstdint>
@@ -49,6 +50,18 @@ inline std::vector<Eigen::Vector3f> sample_scene(const mesh::TriangleMesh& scene
                               r2 * (scene.vertices[f[2]] - scene.vertices[f[0]]);
     points.push_back(p + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
   }
+  return points;
+}
+
+/// The scene around a sensor at its true pose `T` (map <- sensor), in the sensor's frame: a
+/// fresh noisy sampling within 40 m, as many points as a keyframe keeps of an outdoor scan
+/// (one per 0.4 m voxel).
+inline std::vector<Eigen::Vector3f> keyframe_scan_at(const mesh::TriangleMesh& scene,
+                                                     const Eigen::Isometry3d& T, uint32_t seed) {
+  std::vector<Eigen::Vector3f> points =
+      sample_scene(scene, T.translation().cast<float>(), 40.0f, 6000, 0.02f, seed);
+  const Eigen::Isometry3d T_sensor_map = T.inverse();
+  for (Eigen::Vector3f& p : points) p = (T_sensor_map * p.cast<double>()).cast<float>();
   return points;
 }
 

@@ -47,17 +47,6 @@ struct OutAndBack {
   }
 };
 
-/// The scene around the sensor at its true pose, in its own frame: a fresh noisy sampling, as
-/// many points as a keyframe keeps of an outdoor scan (one per 0.4 m voxel).
-std::vector<Eigen::Vector3f> scan_at(const mesh::TriangleMesh& scene, const Eigen::Isometry3d& T,
-                                     uint32_t seed) {
-  std::vector<Eigen::Vector3f> points =
-      test::sample_scene(scene, T.translation().cast<float>(), 40.0f, 6000, 0.02f, seed);
-  const Eigen::Isometry3d T_sensor_map = T.inverse();
-  for (Eigen::Vector3f& p : points) p = (T_sensor_map * p.cast<double>()).cast<float>();
-  return points;
-}
-
 double rmse(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b) {
   double sum = 0.0;
   for (size_t i = 0; i < a.size(); ++i)
@@ -103,7 +92,7 @@ TEST(LoopCloser, ClosesLoopsDrivenTheOtherWayAndCorrectsTheDrift) {
   LoopCloser closer(settings);
   for (size_t i = 0; i < path.truth.size(); ++i) {
     closer.add_keyframe(path.stamps_ns[i], path.travelled_m[i], path.odometry[i],
-                        scan_at(scene, path.truth[i], static_cast<uint32_t>(i)));
+                        test::keyframe_scan_at(scene, path.truth[i], static_cast<uint32_t>(i)));
   }
   closer.optimise();
   ASSERT_EQ(closer.keyframes(), path.truth.size());
@@ -150,7 +139,7 @@ TEST(LoopCloser, OnlyTrueLoopsWhereTheLaneLooksAlikeEverywhere) {
   // The way out alone.
   for (size_t i = 0; i < 27; ++i) {
     closer.add_keyframe(path.stamps_ns[i], path.travelled_m[i], path.odometry[i],
-                        scan_at(scene, path.truth[i], static_cast<uint32_t>(i)));
+                        test::keyframe_scan_at(scene, path.truth[i], static_cast<uint32_t>(i)));
   }
   EXPECT_GT(closer.counts().candidates, 0u);
   expect_true_loops(closer, path);

@@ -17,17 +17,6 @@ namespace {
 
 using test::pose;
 
-/// The scene around the sensor at its true pose, in its own frame (one point per 0.4 m voxel
-/// of an outdoor scan, about), a fresh noisy sampling each time.
-std::vector<Eigen::Vector3f> scan_at(const mesh::TriangleMesh& scene, const Eigen::Isometry3d& T,
-                                     uint32_t seed) {
-  std::vector<Eigen::Vector3f> points =
-      test::sample_scene(scene, T.translation().cast<float>(), 40.0f, 6000, 0.02f, seed);
-  const Eigen::Isometry3d T_sensor_map = T.inverse();
-  for (Eigen::Vector3f& p : points) p = (T_sensor_map * p.cast<double>()).cast<float>();
-  return points;
-}
-
 /// A map of one session: a keyframe every 2 m along the parking lot's middle lane, eastbound.
 std::vector<MapKeyframe> lane_map(const mesh::TriangleMesh& scene, uint32_t session,
                                   const std::vector<Eigen::Isometry3d>& poses) {
@@ -38,7 +27,8 @@ std::vector<MapKeyframe> lane_map(const mesh::TriangleMesh& scene, uint32_t sess
     keyframe.index = static_cast<uint32_t>(i);
     keyframe.stamp_ns = static_cast<int64_t>(i) * 400'000'000;
     keyframe.T_map_sensor = poses[i];
-    const std::vector<Eigen::Vector3f> points = scan_at(scene, poses[i], 100 + session * 1000 + i);
+    const std::vector<Eigen::Vector3f> points =
+        test::keyframe_scan_at(scene, poses[i], 100 + session * 1000 + i);
     keyframe.descriptor = make_scan_context(points);  // level poses: the sensor frame is level
     keyframe.cloud = CompactCloud(points);
     map.push_back(std::move(keyframe));
@@ -70,9 +60,9 @@ TEST(Relocalizer, PlacesARecordingThatStartsFarAwayTurnedTheOtherWay) {
   const Eigen::Isometry3d T_map_session = truth.front();
   std::optional<Relocalization> placed;
   for (size_t k = 0; k < truth.size() && !placed; ++k) {
-    placed = relocalizer.add_keyframe(static_cast<int64_t>(k) * 400'000'000,
-                                      T_map_session.inverse() * truth[k], 2.0 * k,
-                                      scan_at(scene, truth[k], static_cast<uint32_t>(k)));
+    placed = relocalizer.add_keyframe(
+        static_cast<int64_t>(k) * 400'000'000, T_map_session.inverse() * truth[k], 2.0 * k,
+        test::keyframe_scan_at(scene, truth[k], static_cast<uint32_t>(k)));
   }
   ASSERT_TRUE(placed) << relocalizer.counts().candidates << " candidates, "
                       << relocalizer.counts().verified << " verified";
@@ -89,8 +79,9 @@ TEST(Relocalizer, DoesNotPlaceARecordingOfAnotherPlace) {
   Relocalizer relocalizer(lane_map(parking, 0, eastbound(6.0, 58.0)), RelocalizeSettings{});
   for (size_t k = 0; k < 20; ++k) {
     const Eigen::Isometry3d T = pose(0.0, 0.0, 0.0, {2.0 + 2.0 * k, 0.0, 1.5});
-    EXPECT_FALSE(relocalizer.add_keyframe(static_cast<int64_t>(k) * 1'000'000'000, T, 2.0 * k,
-                                          scan_at(corridor, T, static_cast<uint32_t>(k))));
+    EXPECT_FALSE(
+        relocalizer.add_keyframe(static_cast<int64_t>(k) * 1'000'000'000, T, 2.0 * k,
+                                 test::keyframe_scan_at(corridor, T, static_cast<uint32_t>(k))));
   }
   EXPECT_EQ(relocalizer.counts().keyframes, 20u);
 }
@@ -105,9 +96,9 @@ TEST(Relocalizer, AGuessOutsideTheMapPlacesNothing) {
   const std::vector<Eigen::Isometry3d> truth = eastbound(20.0, 40.0);
   std::optional<Relocalization> placed;
   for (size_t k = 0; k < truth.size() && !placed; ++k) {
-    placed = relocalizer.add_keyframe(static_cast<int64_t>(k) * 400'000'000,
-                                      truth.front().inverse() * truth[k], 2.0 * k,
-                                      scan_at(scene, truth[k], static_cast<uint32_t>(50 + k)));
+    placed = relocalizer.add_keyframe(
+        static_cast<int64_t>(k) * 400'000'000, truth.front().inverse() * truth[k], 2.0 * k,
+        test::keyframe_scan_at(scene, truth[k], static_cast<uint32_t>(50 + k)));
   }
   ASSERT_TRUE(placed);
   EXPECT_EQ(placed->found_by, "descriptor");
