@@ -55,11 +55,12 @@ inline std::vector<Eigen::Vector3f> sample_scene(const mesh::TriangleMesh& scene
 
 /// The scene around a sensor at its true pose `T` (map <- sensor), in the sensor's frame: a
 /// fresh noisy sampling within 40 m, as many points as a keyframe keeps of an outdoor scan
-/// (one per 0.4 m voxel).
+/// (one per 0.4 m voxel), or `count`.
 inline std::vector<Eigen::Vector3f> keyframe_scan_at(const mesh::TriangleMesh& scene,
-                                                     const Eigen::Isometry3d& T, uint32_t seed) {
+                                                     const Eigen::Isometry3d& T, uint32_t seed,
+                                                     int count = 6000) {
   std::vector<Eigen::Vector3f> points =
-      sample_scene(scene, T.translation().cast<float>(), 40.0f, 6000, 0.02f, seed);
+      sample_scene(scene, T.translation().cast<float>(), 40.0f, count, 0.02f, seed);
   const Eigen::Isometry3d T_sensor_map = T.inverse();
   for (Eigen::Vector3f& p : points) p = (T_sensor_map * p.cast<double>()).cast<float>();
   return points;

@@ -19,7 +19,8 @@ using test::pose;
 
 /// A map of one session: a keyframe every 2 m along the parking lot's middle lane, eastbound.
 std::vector<MapKeyframe> lane_map(const mesh::TriangleMesh& scene, uint32_t session,
-                                  const std::vector<Eigen::Isometry3d>& poses) {
+                                  const std::vector<Eigen::Isometry3d>& poses,
+                                  int points_each = 6000) {
   std::vector<MapKeyframe> map;
   for (size_t i = 0; i < poses.size(); ++i) {
     MapKeyframe keyframe;
@@ -28,7 +29,7 @@ std::vector<MapKeyframe> lane_map(const mesh::TriangleMesh& scene, uint32_t sess
     keyframe.stamp_ns = static_cast<int64_t>(i) * 400'000'000;
     keyframe.T_map_sensor = poses[i];
     const std::vector<Eigen::Vector3f> points =
-        test::keyframe_scan_at(scene, poses[i], 100 + session * 1000 + i);
+        test::keyframe_scan_at(scene, poses[i], 100 + session * 1000 + i, points_each);
     keyframe.descriptor = make_scan_context(points);  // level poses: the sensor frame is level
     keyframe.cloud = CompactCloud(points);
     map.push_back(std::move(keyframe));
@@ -136,6 +137,35 @@ TEST(SessionLinks, ALaterSessionPlacedOffIsPulledOntoTheFirst) {
   for (size_t k = 0; k < first_later; ++k)
     EXPECT_LT((linked.poses[k].translation() - keyframes[k].T_map_sensor.translation()).norm(),
               0.05);
+}
+
+TEST(SessionLinks, ASessionLinkedAtEveryKeyframeKeepsItsShape) {
+  // Each link moves the rest of the session, and the next link is measured from the poses it
+  // moved. A pose that is a product of poses is off SO(3) by rounding (here 1e-9, as a scale);
+  // that must not build up over the links into a scale that stretches the session's clouds
+  // until no registration fits them.
+  const mesh::TriangleMesh scene = build_scene("parking");
+  const std::vector<Eigen::Isometry3d> truth = eastbound(6.0, 58.0);
+  // Denser samplings than a keyframe's: every registration fits well, so that only the
+  // poses can make one fail.
+  std::vector<MapKeyframe> keyframes = lane_map(scene, 0, truth, 20000);
+  const size_t first_later = keyframes.size();
+  std::vector<MapKeyframe> later = lane_map(scene, 1, truth, 20000);
+  Eigen::Isometry3d off = pose(0.2 * M_PI / 180.0, 0.0, 0.0, {0.1, -0.1, 0.02});
+  off.linear() *= 1.0 + 1e-9;
+  for (MapKeyframe& k : later) {
+    k.T_map_sensor = off * k.T_map_sensor;
+    keyframes.push_back(std::move(k));
+  }
+  SessionLinkSettings settings;
+  settings.loop.search_rest_m = 0.0;  // a link at every keyframe
+  const SessionLinkResult linked = link_sessions(keyframes, settings, 1u);
+  EXPECT_EQ(linked.links.size(), truth.size());
+  EXPECT_TRUE(linked.rejected.empty());
+  // The first link moves the session by its placement error; every later one by little.
+  for (size_t k = 1; k < linked.links.size(); ++k) EXPECT_LT(linked.links[k].moved_m, 0.03) << k;
+  for (size_t k = 0; k < truth.size(); ++k)
+    EXPECT_LT((linked.poses[first_later + k].translation() - truth[k].translation()).norm(), 0.03);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <utility>
 
+#include "featsense/slam/trajectory/rigid_pose.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 
 namespace featsense::slam::loops {
@@ -100,7 +101,7 @@ SessionLinkResult link_sessions(const std::vector<MapKeyframe>& keyframes,
           reject(to_string(*failed));
           continue;
         }
-        const Eigen::Isometry3d T_map_query = poses[j] * result.T_target_source;
+        const Eigen::Isometry3d T_map_query = orthonormalised(poses[j] * result.T_target_source);
         if ((T_map_query.translation() - poses[i].translation()).norm() > radius_m ||
             rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation()) >
                 radius_deg) {
@@ -115,12 +116,16 @@ SessionLinkResult link_sessions(const std::vector<MapKeyframe>& keyframes,
             edge_information(loop, result.hessian, cloud.size(), result.fitness_m, 0.0);
         edge.loop = true;
         edges.push_back(edge);
-        out.links.push_back({j, i, keyframes[j].session, keyframes[i].session, result.fitness_m,
-                             result.inlier_fraction, 1.0});
+        out.links.push_back(
+            {j, i, keyframes[j].session, keyframes[i].session, result.fitness_m,
+             result.inlier_fraction, 1.0,
+             (T_map_query.translation() - poses[i].translation()).norm(),
+             rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation())});
         // The rest of the session moves with the keyframe: the next searches start from
         // where this link puts them.
-        const Eigen::Isometry3d moved = T_map_query * poses[i].inverse();
-        for (size_t k = i; k < end; ++k) poses[k] = moved * poses[k];
+        // Kept orthonormal: each link's move is measured from poses it moved before.
+        const Eigen::Isometry3d moved = orthonormalised(T_map_query * poses[i].inverse());
+        for (size_t k = i; k < end; ++k) poses[k] = orthonormalised(moved * poses[k]);
         last_link_m = keyframes[i].travelled_m;
         linked = true;
         break;

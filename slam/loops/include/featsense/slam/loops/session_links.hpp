@@ -43,6 +43,9 @@ struct SessionLink {
   double fitness_m = 0.0;
   double inlier_fraction = 0.0;
   double weight = 1.0;  ///< the graph's final weight of the link
+  /// How far the link moved `to` from where the session put it when it was accepted.
+  double moved_m = 0.0;
+  double moved_deg = 0.0;
 };
 
 struct SessionLinkResult {
