@@ -21,6 +21,7 @@
 #include "map_sessions.hpp"
 #include "map_store.hpp"
 #include "saved_map.hpp"
+#include "session_links_report.hpp"
 
 namespace featsense::app {
 namespace {
@@ -117,10 +118,7 @@ void run_merge(const MergeOptions& options, const CliContext& context) {
       "the sessions",
       options.second, options.first, placement.agreeing, 1000.0 * placement.fitness_m,
       linked.links.size());
-  report["links"] = {{"count", linked.links.size()},
-                     {"candidates", linked.candidates},
-                     {"rejected", linked.rejected},
-                     {"unlinked_sessions", linked.unlinked_sessions}};
+  report["links"] = session_links_json(linked, keyframes);
 
   std::vector<SessionRemap> sessions =
       session_remaps(first, keyframes, 0, 0, Eigen::Isometry3d::Identity(), linked.poses,

@@ -20,6 +20,7 @@
 #include "json_output.hpp"
 #include "map_store.hpp"
 #include "saved_map.hpp"
+#include "session_links_report.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
 #include "timing_stats.hpp"
@@ -254,7 +255,8 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
     std::ostringstream why;
     why << request.session.input << " could not be placed in " << request.old_map.string()
         << ": none of the " << c.keyframes << " keyframes of its "
-        << (loops.relocalize_gave_up ? "first " + std::to_string(max_scans) : std::string(""))
+        << (loops.relocalize_gave_up ? "first " + std::to_string(max_scans)
+                                     : std::to_string(loops.before.size()))
         << " scans"
         << " matched the map's " << saved.keyframes.size() << " keyframes (" << c.candidates
         << " candidates, " << c.verified << " verified; rejected: " << rejections_text(c.rejected)
@@ -305,12 +307,6 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
   if (moved_m > quarter_voxel_m) not_again = why_sessions_cannot_be_read(saved, config);
   const bool again = moved_m > quarter_voxel_m && not_again.empty();
 
-  std::map<std::string, size_t> links_between;
-  size_t weak_links = 0;
-  for (const slam::loops::SessionLink& link : linked.links) {
-    ++links_between[std::to_string(link.from_session) + "-" + std::to_string(link.to_session)];
-    if (link.weight < 0.5) ++weak_links;
-  }
   char placement_text[200];
   std::snprintf(placement_text, sizeof placement_text,
                 "relocalized: keyframe %zu matched session %u keyframe %u (fitness %.1f mm, %zu "
@@ -332,11 +328,7 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
   report["inlier_fraction"] = placement.inlier_fraction;
   report["agreeing"] = placement.agreeing;
   report["T_map_session"] = pose_json(placement.T_map_session);
-  report["links"] = {
-      {"count", linked.links.size()},      {"between_sessions", links_between},
-      {"candidates", linked.candidates},   {"rejected", linked.rejected},
-      {"weight_below_half", weak_links},   {"unlinked_sessions", linked.unlinked_sessions},
-      {"link_s", linked.link_ms / 1000.0}, {"optimise_s", linked.optimise_ms / 1000.0}};
+  report["links"] = session_links_json(linked, keyframes);
   report["earlier_sessions"] = {
       {"moved_max_m", moved_m}, {"moved_max_deg", moved_deg}, {"mapped_again", again}};
   if (moved_m <= quarter_voxel_m) {
