@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <system_error>
 
 namespace featsense::test {
 
@@ -17,12 +19,35 @@ inline std::filesystem::path shared_data_dir() {
   return std::filesystem::is_directory(dir) ? dir : std::filesystem::path();
 }
 
+/// This process's scratch folders, removed when it exits normally (a run of the suite
+/// writes maps and recordings of several GB; kept after a crash, for a look). Set
+/// FEATSENSE_KEEP_TEST_FILES to keep them always.
+class ProcessScratch {
+ public:
+  ProcessScratch()
+      : pid_(::getpid()),
+        root_(std::filesystem::temp_directory_path() / "featsense-test" / std::to_string(pid_)) {}
+  ProcessScratch(const ProcessScratch&) = delete;
+  ProcessScratch& operator=(const ProcessScratch&) = delete;
+  ~ProcessScratch() {
+    // A forked child that exits normally must not remove its parent's files.
+    if (::getpid() != pid_ || std::getenv("FEATSENSE_KEEP_TEST_FILES") != nullptr) return;
+    std::error_code ignored;
+    std::filesystem::remove_all(root_, ignored);
+  }
+  const std::filesystem::path& root() const { return root_; }
+
+ private:
+  pid_t pid_;
+  std::filesystem::path root_;
+};
+
 /// A scratch folder for one test, emptied first.
 inline std::filesystem::path scratch_dir(const std::string& name) {
   // Per process: ctest runs test programs, and the instances of a parameterised test, in
   // parallel, and two of them must never empty each other's folder.
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "featsense-test" / std::to_string(::getpid()) / name;
+  static const ProcessScratch process;
+  const std::filesystem::path dir = process.root() / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
