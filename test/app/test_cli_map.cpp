@@ -410,12 +410,7 @@ TEST_F(CliMap, KillNineLeavesAReadableMap) {
   const LongRun run("cli_map_kill");
   const fs::path& out = run.out();
   const pid_t child = run.start();
-  ASSERT_TRUE(wait_for_first_flush(out / "map.h5.journal", child))
-      << "the run ended before its first flush";
-  kill(child, SIGKILL);
-  int status = 0;
-  waitpid(child, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status));
+  ASSERT_TRUE(killed_after_first_flush(out / "map.h5.journal", child));
   storage::Hdf5ChunkStore store(out / "map.h5");  // replays the journal
   EXPECT_GT(store.keys().size(), 0u);
   for (const storage::ChunkKey& key : store.keys()) ASSERT_TRUE(store.read(key).has_value());

@@ -3,8 +3,6 @@
 // recording of another place is refused with the map left as it was, and `featsense merge`.
 
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/file_bytes.hpp"
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/small_map_options.hpp"
@@ -76,13 +75,6 @@ std::map<long long, std::vector<double>> read_positions(const fs::path& path) {
     out[std::llround(t * 1e6)] = {x, y, z};
   }
   return out;
-}
-
-std::string file_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
 }
 
 /// The same chunks, and every voxel the same weight and a value within one fixed-point step
@@ -260,12 +252,7 @@ TEST_F(CliMapSessions, KillNineDuringAContinuedRunLeavesTheMapReadable) {
                                           kSmall + " --set map.flush_interval=1",
                                       dir / "continue.log");
   // The recording is placed first (nothing written), then mapped into the map.
-  ASSERT_TRUE(wait_for_first_flush(out / "map.h5.journal", child, std::chrono::seconds(300)))
-      << "the run ended before its first flush";
-  kill(child, SIGKILL);
-  int status = 0;
-  waitpid(child, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status));
+  ASSERT_TRUE(killed_after_first_flush(out / "map.h5.journal", child, std::chrono::seconds(300)));
   storage::Hdf5ChunkStore store(out / "map.h5");  // replays the journal
   for (const storage::ChunkKey& key : before) EXPECT_TRUE(store.read(key).has_value());
   for (const storage::ChunkKey& key : store.keys()) ASSERT_TRUE(store.read(key).has_value());

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
+#include "common/file_bytes.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 
@@ -56,13 +56,6 @@ TEST(CliSimulate, SensorFromOusterMetadata) {
   EXPECT_EQ(j["frames"], 1);
   EXPECT_EQ(j["rows"], 128);  // the unit's metadata: OS-1-128, 1024x10
   EXPECT_EQ(j["cols"], 1024);
-}
-
-std::string file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
 }
 
 TEST(CliSimulate, SameSeedSameFilesOtherSeedOtherNoise) {

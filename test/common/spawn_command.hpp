@@ -1,8 +1,11 @@
 #pragma once
 // Runs the featsense program in the background, for tests that stop it with a signal.
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <chrono>
 #include <filesystem>
@@ -37,6 +40,21 @@ inline bool wait_for_first_flush(const std::filesystem::path& journal, pid_t chi
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return false;
+}
+
+/// Waits for the child's first flush (wait_for_first_flush), then kills it with SIGKILL and
+/// reaps it, whether the flush came or not (a child left running would outlive the test).
+/// Fails where the child ended before its first flush or was not ended by the kill.
+inline ::testing::AssertionResult killed_after_first_flush(
+    const std::filesystem::path& journal, pid_t child,
+    std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  const bool flushed = wait_for_first_flush(journal, child, timeout);
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  if (!flushed) return ::testing::AssertionFailure() << "the run ended before its first flush";
+  if (!WIFSIGNALED(status)) return ::testing::AssertionFailure() << "the kill did not end the run";
+  return ::testing::AssertionSuccess();
 }
 
 }  // namespace featsense::test

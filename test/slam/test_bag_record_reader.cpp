@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/file_bytes.hpp"
 #include "common/test_data.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "rosbag/bag_catalog.hpp"
@@ -30,13 +31,6 @@ constexpr TestCompression kAllCompressions[] = {TestCompression::kNone, TestComp
 
 std::string as_string(const std::vector<uint8_t>& bytes) {
   return std::string(bytes.begin(), bytes.end());
-}
-
-std::string read_file(const std::filesystem::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return text.str();
 }
 
 struct ReadBack {
@@ -162,7 +156,7 @@ TEST(BagRecordReader, RealOusterBagCatalog) {
 
   // Streaming every message: the lidar payloads have the packet size of the metadata's
   // profile (RNG15_RFL8_NIR8: 4-byte pixels; PACKET_FORMAT.md), the IMU ones 48 bytes.
-  const std::string bag = read_file(path);
+  const std::string bag = test::file_bytes(path);
   const ReadBack read = read_all(bag);
   EXPECT_TRUE(read.warnings.empty());
   EXPECT_TRUE(read.stats.reached_end);

@@ -19,6 +19,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "common/file_bytes.hpp"
 #include "common/pcd_test_writer.hpp"
 #include "common/test_data.hpp"
 #include "featsense/slam/io/cloud_files.hpp"
@@ -51,13 +52,6 @@ std::string test_pcd(const std::vector<TestField>& fields,
 void write_file(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
 }
 
 /// The InputError message of decoding `bytes`, or "" when it decodes.
@@ -301,7 +295,7 @@ std::vector<double> row_elevations_deg(const Scan& scan) {
 }
 
 OrganizeStats organize_stats_of(const fs::path& path) {
-  const DecodedCloud d = decode_pcd(read_file(path), path.string());
+  const DecodedCloud d = decode_pcd(test::file_bytes(path), path.string());
   OrganizeStats stats;
   cloud_to_scan(d, choose_sensor(d, SourceOptions{}, path.string()), path.string(), &stats);
   return stats;
@@ -357,7 +351,7 @@ TEST(PcdReader, Vlp16RecordingOrganizesIntoSixteenRings) {
 /// All-zero points of an HDL-32 file, counted straight from its bytes (x y z intensity
 /// float32 after "DATA binary\n").
 size_t count_zero_points(const fs::path& path, size_t* total) {
-  const std::string bytes = read_file(path);
+  const std::string bytes = test::file_bytes(path);
   const size_t start = bytes.find("DATA binary\n") + 12;
   *total = (bytes.size() - start) / 16;
   size_t zeros = 0;
@@ -370,7 +364,7 @@ size_t count_zero_points(const fs::path& path, size_t* total) {
 }
 
 Scan read_hdl32(const fs::path& path, OrganizeStats* stats) {
-  const DecodedCloud d = decode_pcd(read_file(path), path.string());
+  const DecodedCloud d = decode_pcd(test::file_bytes(path), path.string());
   std::string why;
   const config::SensorModel sensor = choose_sensor(d, SourceOptions{}, path.string(), &why);
   EXPECT_EQ(sensor.name, "hdl32") << why;

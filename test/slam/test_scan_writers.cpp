@@ -5,10 +5,9 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 
+#include "common/file_bytes.hpp"
 #include "common/test_data.hpp"
 #include "featsense/slam/io/cloud_files.hpp"
 #include "featsense/slam/io/readers.hpp"
@@ -49,19 +48,12 @@ Scan test_scan() {
   return scan;
 }
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
 TEST(ScanWriters, PcdRoundTripGivesTheSameScan) {
   const Scan scan = test_scan();
   const fs::path file = test::scratch_dir("scan_writers_pcd") / "scan.pcd";
   write_scan_pcd(scan, file.string());
 
-  const std::string bytes = read_file(file);
+  const std::string bytes = test::file_bytes(file);
   EXPECT_NE(bytes.find("FIELDS x y z range t ring intensity reflectivity\n"), std::string::npos);
   EXPECT_NE(bytes.find("WIDTH 1800\nHEIGHT 16\n"), std::string::npos);
   EXPECT_NE(bytes.find("DATA binary\n"), std::string::npos);
@@ -88,7 +80,7 @@ TEST(ScanWriters, PlyRoundTripGivesTheValidPoints) {
   const Scan scan = test_scan();
   const fs::path file = test::scratch_dir("scan_writers_ply") / "scan.ply";
   write_scan_ply(scan, file.string());
-  const DecodedCloud decoded = decode_ply(read_file(file), file.string());
+  const DecodedCloud decoded = decode_ply(test::file_bytes(file), file.string());
   EXPECT_EQ(decoded.cloud.size(), scan.valid_count());
   EXPECT_FALSE(decoded.cloud.ring_counts_up);  // ring = row, row 0 highest
 
@@ -113,7 +105,7 @@ TEST(ScanWriters, KittiBinHoldsValidPointsWithNormalisedIntensity) {
   Scan scan = test_scan();
   const fs::path file = test::scratch_dir("scan_writers_bin") / "000000.bin";
   write_scan_kitti_bin(scan, file.string());
-  const std::string bytes = read_file(file);
+  const std::string bytes = test::file_bytes(file);
   ASSERT_EQ(bytes.size(), scan.valid_count() * 16);
   // Scan::intensity() prefers reflectivity; its largest value among valid cells is 99.
   const ScanChannel& reflectivity = *scan.channel("reflectivity");
@@ -142,7 +134,7 @@ TEST(ScanWriters, KittiBinHoldsValidPointsWithNormalisedIntensity) {
     }
   }
   write_scan_kitti_bin(scan, file.string());
-  const std::string from_behind = read_file(file);
+  const std::string from_behind = test::file_bytes(file);
   const size_t first = scan.index(0, 900);  // (0 + 900) % 3 == 0: a return
   ASSERT_TRUE(scan.valid[first]);
   float point[4];
@@ -151,7 +143,7 @@ TEST(ScanWriters, KittiBinHoldsValidPointsWithNormalisedIntensity) {
   // No intensity channel at all: zeros.
   scan.channels.clear();
   write_scan_kitti_bin(scan, file.string());
-  const std::string plain = read_file(file);
+  const std::string plain = test::file_bytes(file);
   float intensity = 1;
   std::memcpy(&intensity, plain.data() + 12, 4);
   EXPECT_EQ(intensity, 0.0f);
