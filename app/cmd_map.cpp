@@ -30,6 +30,7 @@
 #include "map_pipeline.hpp"
 #include "map_report.hpp"
 #include "map_sessions.hpp"
+#include "map_store.hpp"
 #include "report_html.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
@@ -292,34 +293,38 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                    loops->gravity.observations > 0 ? ", levelled by gravity" : "");
       const fs::path replay_path = out / "map.corrected.h5";
       std::optional<MapPassOutput> replayed;
+      bool replay_interrupted = false;
       try {
-        const std::unique_ptr<slam::ScanSource> again = reopen();
-        // Each scan deskewed as the first pass placed it (scan_motions.hpp), from its
-        // corrected pose.
-        const std::unique_ptr<slam::ScanLocator> corrected =
-            config.odometry.deskew ? slam::make_replay_locator(loops->corrected, first.scan_motions)
-                                   : slam::make_given_pose_locator(loops->corrected, false);
-        PipelineSettings replay = pipeline;
-        replay.refine.reset();
-        replay.loops.reset();
-        SessionDescription corrected_session = session;
-        corrected_session.placement += ", loops closed";
-        replayed = run_map_pass(*again, *corrected, replay, config,
-                                {replay_path, info.sensor.name, std::nullopt, true,
-                                 corrected_session, &loops->keyframes});
+        build_then_replace(replay_path, out / "map.h5", [&] {
+          const std::unique_ptr<slam::ScanSource> again = reopen();
+          // Each scan deskewed as the first pass placed it (scan_motions.hpp), from its
+          // corrected pose.
+          const std::unique_ptr<slam::ScanLocator> corrected =
+              config.odometry.deskew
+                  ? slam::make_replay_locator(loops->corrected, first.scan_motions)
+                  : slam::make_given_pose_locator(loops->corrected, false);
+          PipelineSettings replay = pipeline;
+          replay.refine.reset();
+          replay.loops.reset();
+          SessionDescription corrected_session = session;
+          corrected_session.placement += ", loops closed";
+          replayed = run_map_pass(*again, *corrected, replay, config,
+                                  {replay_path, info.sensor.name, std::nullopt, true,
+                                   corrected_session, &loops->keyframes});
+          if (replayed->result.interrupted) throw Interrupted("interrupted");
+        });
+      } catch (const Interrupted&) {
+        replay_interrupted = true;
       } catch (const std::exception& e) {
         // The input changed or went away since the first pass: its map stays.
         spdlog::warn("the second pass failed: {}; the map keeps the odometry's poses", e.what());
         second_pass = std::string("failed (") + e.what() + "): the map keeps the odometry's poses";
-        std::error_code ignored;
-        fs::remove(replay_path, ignored);
+        replayed.reset();
       }
-      if (replayed && replayed->result.interrupted) {
-        fs::remove(replay_path);
+      if (replay_interrupted) {
         second_pass = "interrupted: the map keeps the odometry's poses";
         pass.result.interrupted = true;
       } else if (replayed) {
-        fs::rename(replay_path, out / "map.h5");
         second_pass = "mapped again with the corrected poses";
         pass = std::move(*replayed);
         second = pass.result;

@@ -373,9 +373,9 @@ ContinuedRun map_into_saved_map(slam::ScanSource& source, slam::ScanLocator& odo
     run.second_pass = "mapped into the saved map with the placed, corrected poses";
     return run;
   }
+  const fs::path rebuilt = request.out / "map.rebuilt.h5";
   try {
-    build_then_replace(request.out / "map.rebuilt.h5", map_out, [&] {
-      const fs::path rebuilt = request.out / "map.rebuilt.h5";
+    build_then_replace(rebuilt, map_out, [&] {
       remap_sessions(
           session_remaps(saved, keyframes, 0, 0, Eigen::Isometry3d::Identity(), linked.poses,
                          "; moved by the links of session " + std::to_string(session_id)),

@@ -17,8 +17,7 @@ nlohmann::json keyframe_json(const slam::loops::MapKeyframe& keyframe,
           {"at", {at.x(), at.y(), at.z()}}};
 }
 
-}  // namespace
-
+/// Links whose final weight is below a half: the graph found them at odds with the rest.
 size_t weak_links(const slam::loops::SessionLinkResult& linked) {
   size_t weak = 0;
   for (const slam::loops::SessionLink& link : linked.links) {
@@ -26,6 +25,8 @@ size_t weak_links(const slam::loops::SessionLinkResult& linked) {
   }
   return weak;
 }
+
+}  // namespace
 
 nlohmann::json session_links_json(const slam::loops::SessionLinkResult& linked,
                                   const std::vector<slam::loops::MapKeyframe>& keyframes) {

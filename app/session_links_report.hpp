@@ -17,7 +17,4 @@ namespace featsense::app {
 nlohmann::json session_links_json(const slam::loops::SessionLinkResult& linked,
                                   const std::vector<slam::loops::MapKeyframe>& keyframes);
 
-/// Links whose final weight is below a half: the graph found them at odds with the rest.
-size_t weak_links(const slam::loops::SessionLinkResult& linked);
-
 }  // namespace featsense::app
