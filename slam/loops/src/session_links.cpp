@@ -102,9 +102,11 @@ SessionLinkResult link_sessions(const std::vector<MapKeyframe>& keyframes,
           continue;
         }
         const Eigen::Isometry3d T_map_query = orthonormalised(poses[j] * result.T_target_source);
-        if ((T_map_query.translation() - poses[i].translation()).norm() > radius_m ||
-            rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation()) >
-                radius_deg) {
+        // How far the link moves the keyframe from where the session put it.
+        const double moved_m = (T_map_query.translation() - poses[i].translation()).norm();
+        const double moved_deg =
+            rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation());
+        if (moved_m > radius_m || moved_deg > radius_deg) {
           reject(to_string(LoopRejection::inconsistent));
           continue;
         }
@@ -116,11 +118,8 @@ SessionLinkResult link_sessions(const std::vector<MapKeyframe>& keyframes,
             edge_information(loop, result.hessian, cloud.size(), result.fitness_m, 0.0);
         edge.loop = true;
         edges.push_back(edge);
-        out.links.push_back(
-            {j, i, keyframes[j].session, keyframes[i].session, result.fitness_m,
-             result.inlier_fraction, 1.0,
-             (T_map_query.translation() - poses[i].translation()).norm(),
-             rotation_angle_deg(T_map_query.rotation().transpose() * poses[i].rotation())});
+        out.links.push_back({j, i, keyframes[j].session, keyframes[i].session, result.fitness_m,
+                             result.inlier_fraction, 1.0, moved_m, moved_deg});
         // The rest of the session moves with the keyframe: the next searches start from
         // where this link puts them.
         // Kept orthonormal: each link's move is measured from poses it moved before.

@@ -10,6 +10,8 @@
 #include <optional>
 #include <vector>
 
+#include "featsense/slam/trajectory/rigid_pose.hpp"
+
 namespace featsense::slam::refine {
 namespace {
 
@@ -34,11 +36,11 @@ Eigen::Isometry3d apply_left(const Eigen::Isometry3d& T, const Vector6d& step) {
   const Eigen::Matrix3d turn = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
                                            : Eigen::Matrix3d::Identity();
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = turn * T.linear();
+  out.translation() = turn * T.translation() + step.tail<3>();
   // Orthonormal again at every step: a guess that is a product of poses is slightly off
   // SO(3), and a result passed on as the next guess would carry that along.
-  out.linear() = Eigen::Quaterniond(turn * T.linear()).normalized().toRotationMatrix();
-  out.translation() = turn * T.translation() + step.tail<3>();
-  return out;
+  return orthonormalised(out);
 }
 
 }  // namespace
