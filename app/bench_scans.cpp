@@ -2,8 +2,8 @@
 
 #include <optional>
 
-#include "featsense/slam/sim/box_room_source.hpp"
-#include "scan_to_rays.hpp"
+#include "featsense/mapping/scan_to_rays.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 
 namespace featsense::app {
 
@@ -28,7 +28,7 @@ PreparedScans prepare_builtin(const std::string& scene, int count) {
         slam::column_poses(*scan, placement.T_map_sensor, [&](double t) {
           return std::optional<Eigen::Isometry3d>(slam::box_room_pose(settings, frame_start + t));
         });
-    prepared.rays.push_back(scan_to_rays(*scan, placement));
+    prepared.rays.push_back(mapping::scan_to_rays(*scan, placement));
     prepared.input_points += prepared.rays.back().size();
     ++frame;
   }
@@ -44,7 +44,7 @@ PreparedScans prepare_recording(const InputOptions& input, const config::Config&
   while (static_cast<int>(prepared.rays.size()) < count) {
     std::optional<slam::Scan> scan = source->next();
     if (!scan) break;
-    prepared.rays.push_back(scan_to_rays(*scan, slam::ScanPlacement{}));
+    prepared.rays.push_back(mapping::scan_to_rays(*scan, slam::ScanPlacement{}));
     prepared.input_points += prepared.rays.back().size();
   }
   if (prepared.rays.empty()) throw slam::InputError(input.input + ": no readable frame");

@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
+#include "featsense/mapping/loop_stage.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/odometry/feature_odometry.hpp"
@@ -22,7 +23,6 @@
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
-#include "loop_stage.hpp"
 #include "map_report.hpp"
 #include "simulate_job.hpp"
 #include "source_options.hpp"
@@ -279,7 +279,7 @@ class BenchLoops {
 
   /// The corrected poses of every scan added, from the graph as it is.
   slam::Trajectory corrected() const {
-    return corrected_path(closer_.correction(), path_, travelled_m_);
+    return mapping::corrected_path(closer_.correction(), path_, travelled_m_);
   }
 
   /// A deliberately wrong loop added to the graph (and optimised): the keyframe three

@@ -14,61 +14,26 @@
 #include "commands.hpp"
 #include "eval_json.hpp"
 #include "featsense/config/config_error.hpp"
-#include "featsense/slam/loops/loop_closer.hpp"
-#include "featsense/slam/odometry/odometry_locator.hpp"
-#include "featsense/slam/refine/segment_refiner.hpp"
-#include "featsense/slam/trajectory/given_pose_locator.hpp"
-#include "featsense/slam/trajectory/scan_motions.hpp"
+#include "featsense/mapping/mapper.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "front_end_report.hpp"
 #include "json_output.hpp"
-#include "map_continue.hpp"
 #include "map_job.hpp"
+#include "map_options.hpp"
 #include "map_outputs.hpp"
-#include "map_pass.hpp"
-#include "map_pipeline.hpp"
 #include "map_report.hpp"
-#include "map_sessions.hpp"
-#include "map_store.hpp"
+#include "progress.hpp"
 #include "report_html.hpp"
+#include "session_links_report.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
-#include "timing_stats.hpp"
 #include "trajectory_error_plot.hpp"
 
 namespace featsense::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// --start / --end: a frame index ("120") or seconds after the first scan ("12.5s").
-void parse_range_end(const std::string& text, const char* option, std::optional<uint64_t>& frame,
-                     std::optional<double>& seconds) {
-  std::istringstream in(text);
-  double value = 0.0;
-  if (!(in >> value) || value < 0.0) {
-    throw config::ConfigError(std::string(option) + ": expected a frame index or seconds like " +
-                              "12.5s, got '" + text + "'");
-  }
-  std::string unit;
-  in >> unit;
-  if (unit == "s") {
-    seconds = value;
-  } else if (unit.empty() && value == static_cast<double>(static_cast<uint64_t>(value))) {
-    frame = static_cast<uint64_t>(value);
-  } else {
-    throw config::ConfigError(std::string(option) + ": expected a frame index or seconds like " +
-                              "12.5s, got '" + text + "'");
-  }
-}
-
-FrameRange frame_range(const MapOptions& options) {
-  FrameRange range;
-  if (options.start) parse_range_end(*options.start, "--start", range.first_frame, range.first_s);
-  if (options.end) parse_range_end(*options.end, "--end", range.last_frame, range.last_s);
-  return range;
-}
 
 slam::Trajectory read_poses(const MapOptions& options) {
   if (options.gt_times && options.gt_format == "tum") {
@@ -144,15 +109,8 @@ PlanInputs plan_inputs(const MapOptions& options, const slam::Trajectory& final_
   return plan;
 }
 
-/// Why the loop closure does not run (empty: it does).
-std::string loop_closure_off_because(bool odometry, const config::Config& config) {
-  if (!odometry) return "the poses are given";
-  if (!config.loop.enabled) return "loop.enabled is false";
-  return "";
-}
-
 /// A pass's speed, for the report of a run that mapped twice.
-nlohmann::json pass_json(const PipelineResult& run) {
+nlohmann::json pass_json(const mapping::PassResult& run) {
   return {
       {"scans", run.frames_mapped},
       {"wall_s", run.wall_s},
@@ -182,232 +140,164 @@ MapOutcome run_map(const MapOptions& options, const CliContext& context) {
                        reopen);
 }
 
-MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
-                         const std::optional<KnownTrajectory>& truth, const MapOptions& options,
-                         config::Config config, const MeshReferences& references,
-                         const CliContext& context, const SourceReopener& reopen) {
-  const FrameRange range = frame_range(options);
-  const slam::SourceInfo& info = source.info();
-  std::unique_ptr<slam::odometry::OdometryLocator> odometry;
-  std::unique_ptr<slam::ScanLocator> given;
-  if (poses) {
-    given = slam::make_given_pose_locator(std::move(*poses), config.odometry.deskew);
-  } else {
-    // A recording continuing a map starts in its own frame until it is placed in the map.
-    const bool anchored =
-        truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from;
-    odometry = slam::odometry::make_odometry_locator(
-        config, anchored ? truth->poses.poses.front() : Eigen::Isometry3d::Identity());
-  }
-  slam::ScanLocator* locator = given ? given.get() : odometry.get();
+namespace {
 
-  const fs::path out(options.output);
-  fs::create_directories(out);
-  PipelineSettings pipeline;
-  pipeline.flush_interval_s = config.map.flush_interval_s;
-  pipeline.range = range;
-  pipeline.total_frames = info.frames;
-  pipeline.quiet = context.quiet;
-  pipeline.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
-  pipeline.integrate = !options.poses_only;
-  if (odometry && config.refine.enabled) pipeline.refine = slam::refine::from_config(config);
-  const std::string no_loops = loop_closure_off_because(odometry != nullptr, config);
-  if (no_loops.empty()) pipeline.loops = slam::loops::from_config(config);
-  spdlog::info("mapping {} ({}; per-point times {}) with {}{}{}", info.path, info.format,
-               info.times.empty() ? std::string("unknown") : info.times, locator->description(),
-               pipeline.refine ? ", refined every " + format_metres(pipeline.refine->distance_m)
-                               : std::string(),
-               pipeline.loops ? ", loops closed" : std::string());
-  if (odometry && !no_loops.empty()) spdlog::info("loop closure off: {}", no_loops);
-  if (!info.imu.empty()) spdlog::info("IMU: {}", info.imu);
-
-  // The run as the map's session: with given poses they place it; the odometry's map frame
-  // is the first scan's, or the true first pose's where the truth is known.
+/// The Mapper's settings for this run: where the map goes, the poses (given, else the
+/// odometry's, anchored at the true first pose where the truth is known), the session.
+mapping::MapperSettings mapper_settings(const slam::SourceInfo& info,
+                                        std::optional<slam::Trajectory> poses,
+                                        const std::optional<KnownTrajectory>& truth,
+                                        const MapOptions& options, config::Config config,
+                                        const SourceReopener& reopen) {
+  mapping::MapperSettings settings;
+  settings.config = std::move(config);
+  settings.sensor = info.sensor;
+  settings.map_path = fs::path(options.output) / "map.h5";
+  settings.overwrite = options.overwrite;
+  settings.continue_from = options.continue_from;
+  settings.integrate = !options.poses_only;
+  settings.reopen = reopen;
+  settings.range = frame_range(options);
   // The input's absolute path: a later session may map it again from elsewhere.
   std::error_code no_path;
   const fs::path absolute_input = fs::absolute(info.path, no_path);
-  SessionDescription session{no_path ? info.path : absolute_input.lexically_normal().string(),
-                             info.format, "given poses"};
-  if (odometry) {
-    session.placement =
-        truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from
-            ? "odometry from the true first pose"
-            : "odometry, the map frame at the first scan";
+  settings.session = {no_path ? info.path : absolute_input.lexically_normal().string(), info.format,
+                      "given poses"};
+  if (poses) {
+    settings.given_poses = std::move(poses);
+    return settings;
   }
-  MapPassOutput pass;
-  PipelineResult first;  // the odometry's poses, before the loops
-  std::string second_pass = "no loop closed, no gravity";
-  std::optional<PipelineResult> second;
-  std::optional<ContinuedRun> continued;
-  if (odometry && options.continue_from) {
-    // A bare recording into a saved map: placed by its keyframes first (map_continue.hpp).
-    ContinueRequest request{*options.continue_from, out,     info.sensor.name,
-                            options.overwrite,      session, std::nullopt};
-    if (options.initial_pose) request.guess = parse_initial_pose(*options.initial_pose);
-    try {
-      continued = map_into_saved_map(source, *odometry, pipeline, config, request, reopen);
-    } catch (const RelocalizationFailed& e) {
-      write_json({{"input", info.path},
-                  {"format", info.format},
-                  {"status", "refused: not placed in the saved map"},
-                  {"relocalization", e.report()}},
-                 (out / "report.json").string());
-      throw;
-    }
-    pass = std::move(continued->pass);
-    first = std::move(continued->first);
-    second = pass.result;
-    second_pass = continued->second_pass;
-  } else {
-    pass = run_map_pass(
-        source, *locator, pipeline, config,
-        {out / "map.h5", info.sensor.name, options.continue_from, options.overwrite, session});
-    first = pass.result;
-  }
-  const std::optional<LoopOutcome>& loops = first.loops;
-  // Levelled by gravity alone, the poses may move less than the map can show: then the first
-  // map stays (a second pass would double the run for nothing).
-  const double quarter_voxel_m = 0.25 * config.map.voxel_size_m;
-  const bool levelled_only = loops && loops->loops.empty() && loops->gravity.observations > 0;
-  if (continued) {
-    // Mapped once, with the poses placed and corrected in the saved map.
-  } else if (levelled_only && loops->corrections_max_m < quarter_voxel_m) {
-    char why[160];
-    std::snprintf(why, sizeof why,
-                  "levelled by gravity, no scan moved more than a quarter voxel (%.1f mm): the "
-                  "map stays",
-                  1000.0 * loops->corrections_max_m);
-    second_pass = why;
-  } else if (loops && loops->corrects_poses()) {
-    if (first.interrupted) {
-      second_pass = "interrupted: the map keeps the odometry's poses";
-    } else if (options.poses_only) {
-      second_pass = "--poses-only: no map";
-    } else if (!reopen) {
-      second_pass = "the input cannot be read twice: the map keeps the odometry's poses";
-    } else {
-      // The recording again, with the corrected poses, into a new file that replaces the
-      // first map only once it is complete.
-      spdlog::info("{} loops closed{}: mapping the recording again with the corrected poses",
-                   loops->loops.size(),
-                   loops->gravity.observations > 0 ? ", levelled by gravity" : "");
-      const fs::path replay_path = out / "map.corrected.h5";
-      std::optional<MapPassOutput> replayed;
-      bool replay_interrupted = false;
-      try {
-        build_then_replace(replay_path, out / "map.h5", [&] {
-          const std::unique_ptr<slam::ScanSource> again = reopen();
-          // Each scan deskewed as the first pass placed it (scan_motions.hpp), from its
-          // corrected pose.
-          const std::unique_ptr<slam::ScanLocator> corrected =
-              config.odometry.deskew
-                  ? slam::make_replay_locator(loops->corrected, first.scan_motions)
-                  : slam::make_given_pose_locator(loops->corrected, false);
-          PipelineSettings replay = pipeline;
-          replay.refine.reset();
-          replay.loops.reset();
-          SessionDescription corrected_session = session;
-          corrected_session.placement += ", loops closed";
-          replayed = run_map_pass(*again, *corrected, replay, config,
-                                  {replay_path, info.sensor.name, std::nullopt, true,
-                                   corrected_session, &loops->keyframes});
-          if (replayed->result.interrupted) throw Interrupted("interrupted");
-        });
-      } catch (const Interrupted&) {
-        replay_interrupted = true;
-      } catch (const std::exception& e) {
-        // The input changed or went away since the first pass: its map stays.
-        spdlog::warn("the second pass failed: {}; the map keeps the odometry's poses", e.what());
-        second_pass = std::string("failed (") + e.what() + "): the map keeps the odometry's poses";
-        replayed.reset();
-      }
-      if (replay_interrupted) {
-        second_pass = "interrupted: the map keeps the odometry's poses";
-        pass.result.interrupted = true;
-      } else if (replayed) {
-        second_pass = "mapped again with the corrected poses";
-        pass = std::move(*replayed);
-        second = pass.result;
-      }
-    }
-  }
-  const PipelineResult& result = pass.result;
-  // The poses the map was made with; with loops closed and no second pass, the corrected ones
-  // all the same (to map later with --gt).
-  const slam::Trajectory& final_poses =
-      continued ? continued->final_poses
-                : (loops && loops->corrects_poses() && !second ? loops->corrected : result.poses);
-  slam::write_tum(final_poses, (out / "trajectory.tum").string());
-  slam::write_kitti(final_poses, (out / "trajectory.kitti").string());
+  // The odometry's map frame is the first scan's, or the true first pose's where the truth is
+  // known (a recording continuing a map starts in its own frame until it is placed).
+  const bool anchored =
+      truth && truth->starts_at_first_scan && !truth->poses.empty() && !options.continue_from;
+  if (anchored) settings.T_map_first_scan = truth->poses.poses.front();
+  settings.session.placement =
+      anchored ? "odometry from the true first pose" : "odometry, the map frame at the first scan";
+  if (options.continue_from && options.initial_pose)
+    settings.initial_guess = parse_initial_pose(*options.initial_pose);
+  return settings;
+}
 
-  MapRunSummary summary;
-  summary.config = &config;
-  summary.input = &info;
-  summary.backend = pass.backend;
-  summary.backend_reason = pass.backend_reason;
-  summary.poses = locator->description() + (pipeline.refine ? ", refined (VGICP)" : "") +
-                  (second ? ", loops closed" : "");
-  summary.pipeline = &result;
-  summary.map = pass.map;
-  summary.map_chunks = pass.map_chunks;
-  summary.continued_chunks = pass.continued_chunks;
-  summary.device_memory_bytes = pass.device_memory_bytes;
-  summary.final_flush_ms = pass.final_flush_ms;
-  nlohmann::json report = map_report_json(summary);
-  if (odometry) {
-    const slam::odometry::OdometryCounts counts = odometry->counts();
+void log_start(const slam::SourceInfo& info, const mapping::Mapper& mapper) {
+  const std::optional<slam::refine::RefineSettings>& refine = mapper.refine_settings();
+  spdlog::info("mapping {} ({}; per-point times {}) with {}{}{}", info.path, info.format,
+               info.times.empty() ? std::string("unknown") : info.times, mapper.front_end(),
+               refine ? ", refined every " + format_metres(refine->distance_m) : std::string(),
+               mapper.loops_off_because().empty() ? ", loops closed" : std::string());
+  if (mapper.estimates_poses() && !mapper.loops_off_because().empty())
+    spdlog::info("loop closure off: {}", mapper.loops_off_because());
+  if (!info.imu.empty()) spdlog::info("IMU: {}", info.imu);
+}
+
+/// Runs the Mapper over `source` with Ctrl+C mapped onto its stop token. A recording that
+/// could not be placed in a saved map leaves a report.json that says why.
+mapping::MapResult run_mapper(slam::ScanSource& source, mapping::MapperSettings settings,
+                              const fs::path& out, const CliContext& context) {
+  const StopSignal stop_signal;
+  const mapping::RunEvents events = terminal_events(stop_signal.token(), context.quiet);
+  try {
+    mapping::Mapper mapper(std::move(settings), events);
+    log_start(source.info(), mapper);
+    return mapping::map_source(source, mapper);
+  } catch (const mapping::RelocalizationFailed& e) {
+    write_json({{"input", source.info().path},
+                {"format", source.info().format},
+                {"status", "refused: not placed in the saved map"},
+                {"relocalization", relocalization_json(e.report())}},
+               (out / "report.json").string());
+    throw;
+  }
+}
+
+/// What the front end did: the odometry, the refinement, the loops, the sessions of the map
+/// and, continuing a map, where the recording was placed.
+void add_front_end_report(const mapping::MapResult& result, const config::Config& config,
+                          const fs::path& out, bool integrate, nlohmann::json& report) {
+  if (result.odometry) {
+    const slam::odometry::OdometryCounts& counts = *result.odometry;
     report["odometry"] = odometry_json(counts, config.odometry.intensity_fusion);
     if (config.odometry.intensity_fusion && counts.intensity_confirmed_scans < counts.scans) {
       spdlog::warn("intensity fusion {}: edges were taken from the geometry alone",
                    intensity_fusion_text(counts, true));
     }
   }
-  if (pipeline.refine) report["refine"] = refine_json(first, *pipeline.refine);
+  if (result.refine) report["refine"] = refine_json(result.first, *result.refine);
   // Every run that made the map, this one last.
-  if (pipeline.integrate && fs::exists(out / "map.h5")) {
-    report["sessions"] = sessions_json(out / "map.h5");
+  if (integrate && fs::exists(out / "map.h5")) report["sessions"] = sessions_json(out / "map.h5");
+  if (result.relocalization) report["relocalization"] = relocalization_json(*result.relocalization);
+  if (result.first.loops) {
+    report["loops"] = loops_json(*result.first.loops, result.first.timings.loops_finish_ms);
+    report["loops"]["second_pass"] = result.second_pass.reason;
+    report["loops"]["first_pass"] = pass_json(result.first);
+    if (result.second) report["loops"]["second_pass_run"] = pass_json(*result.second);
+  } else if (result.odometry) {
+    report["loops"] = {{"enabled", false}, {"why", result.loops_off_because}};
   }
-  if (continued) report["relocalization"] = continued->report;
-  if (loops) {
-    report["loops"] = loops_json(*loops, first.timings.loops_finish_ms);
-    report["loops"]["second_pass"] = second_pass;
-    report["loops"]["first_pass"] = pass_json(first);
-    if (second) report["loops"]["second_pass_run"] = pass_json(*second);
-  } else if (odometry) {
-    report["loops"] = {{"enabled", false}, {"why", no_loops}};
-  }
-  // Where the poses were estimated and the truth is known, the mesh is also scored in the
-  // frame that aligns the two trajectories (evaluate_map_mesh).
+}
+
+/// eval.traj (and the path's error plot) where the truth is known. Returns the alignment of
+/// the estimated path to the true one where it fixes a rotation (estimated poses only), to
+/// score the mesh in that frame too.
+std::optional<Eigen::Isometry3d> add_trajectory_evaluation(
+    const mapping::MapResult& result, const std::optional<KnownTrajectory>& truth,
+    const fs::path& out, nlohmann::json& report) {
+  const slam::Trajectory& final_poses = result.final_poses;
+  if (!truth || final_poses.size() < 2) return std::nullopt;
   std::optional<Eigen::Isometry3d> T_truth_estimate;
-  if (truth && final_poses.size() >= 2) {
-    try {
-      const slam::TrajectoryEvaluationSettings eval_settings;
-      const auto evaluate = [&](const slam::Trajectory& trajectory) {
-        return trajectory_evaluation_json(
-            slam::evaluate_trajectory(trajectory, truth->poses, eval_settings), eval_settings);
-      };
-      const slam::TrajectoryEvaluation final_evaluation =
-          slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
-      report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
-      const bool spans_plane = spans_a_plane(final_poses, kMinAlignmentSpreadM);
-      TrajectoryErrorSeries series =
-          trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front());
-      series.rotation_fixed = spans_plane;
-      report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
-          out, series, report.contains("loops") ? report["loops"] : nlohmann::json::object());
-      if (odometry && spans_plane) T_truth_estimate = final_evaluation.alignment.T;
-      // The front end's own poses too, to show what the loops and the refinement changed.
-      if (loops && loops->corrects_poses())
-        report["eval"]["traj_before_loops"] = evaluate(first.poses);
-      if (first.unrefined_poses && first.unrefined_poses->size() >= 2)
-        report["eval"]["traj_unrefined"] = evaluate(*first.unrefined_poses);
-    } catch (const slam::TrajectoryError& e) {
-      spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
-    }
+  try {
+    const slam::TrajectoryEvaluationSettings eval_settings;
+    const auto evaluate = [&](const slam::Trajectory& trajectory) {
+      return trajectory_evaluation_json(
+          slam::evaluate_trajectory(trajectory, truth->poses, eval_settings), eval_settings);
+    };
+    const slam::TrajectoryEvaluation final_evaluation =
+        slam::evaluate_trajectory(final_poses, truth->poses, eval_settings);
+    report["eval"]["traj"] = trajectory_evaluation_json(final_evaluation, eval_settings);
+    const bool spans_plane = spans_a_plane(final_poses, kMinAlignmentSpreadM);
+    TrajectoryErrorSeries series =
+        trajectory_error_series(final_evaluation, truth->poses, final_poses.stamps_ns.front());
+    series.rotation_fixed = spans_plane;
+    report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
+        out, series, report.contains("loops") ? report["loops"] : nlohmann::json::object());
+    if (result.odometry && spans_plane) T_truth_estimate = final_evaluation.alignment.T;
+    // The front end's own poses too, to show what the loops and the refinement changed.
+    const std::optional<mapping::LoopOutcome>& loops = result.first.loops;
+    if (loops && loops->corrects_poses())
+      report["eval"]["traj_before_loops"] = evaluate(result.first.poses);
+    if (result.first.unrefined_poses && result.first.unrefined_poses->size() >= 2)
+      report["eval"]["traj_unrefined"] = evaluate(*result.first.unrefined_poses);
+  } catch (const slam::TrajectoryError& e) {
+    spdlog::warn("the trajectory could not be compared with the ground truth: {}", e.what());
   }
-  if (!options.no_mesh && !options.poses_only && result.frames_mapped > 0) {
+  return T_truth_estimate;
+}
+
+}  // namespace
+
+MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
+                         const std::optional<KnownTrajectory>& truth, const MapOptions& options,
+                         config::Config config, const MeshReferences& references,
+                         const CliContext& context, const SourceReopener& reopen) {
+  const slam::SourceInfo& info = source.info();
+  const fs::path out(options.output);
+  fs::create_directories(out);
+  const mapping::MapResult result = run_mapper(
+      source, mapper_settings(info, std::move(poses), truth, options, std::move(config), reopen),
+      out, context);
+  // With a continued map's voxel size and tau: the configuration the map keeps.
+  const config::Config& used = result.config;
+  const mapping::PassResult& mapped = result.mapped();
+  slam::write_tum(result.final_poses, (out / "trajectory.tum").string());
+  slam::write_kitti(result.final_poses, (out / "trajectory.kitti").string());
+
+  nlohmann::json report = map_report_json(used, info, result);
+  add_front_end_report(result, used, out, !options.poses_only, report);
+  const std::optional<Eigen::Isometry3d> T_truth_estimate =
+      add_trajectory_evaluation(result, truth, out, report);
+  if (!options.no_mesh && !options.poses_only && mapped.frames_mapped > 0) {
     const MeshErrorOutputs error_outputs{
-        out, plan_inputs(options, final_poses, given != nullptr, truth)};
+        out, plan_inputs(options, result.final_poses, !result.odometry, truth)};
     const MapMesh meshed = mesh_map(out / "map.h5", out, error_outputs.plan);
     report["mesh"] = mesh_json(meshed);
     if (std::optional<nlohmann::json> evaluation =
@@ -419,21 +309,19 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   write_json(report, (out / "report.json").string());
   write_report_html(out, report);
 
-  if (result.frames_mapped == 0) {
-    throw std::runtime_error("no scan was mapped" + (result.warnings.empty()
+  if (mapped.frames_mapped == 0) {
+    throw std::runtime_error("no scan was mapped" + (mapped.warnings.empty()
                                                          ? std::string()
-                                                         : ": " + result.warnings.front()));
+                                                         : ": " + mapped.warnings.front()));
   }
-  if (result.interrupted) {
-    throw Interrupted("interrupted after " + std::to_string(result.frames_mapped) +
+  if (mapped.interrupted) {
+    throw Interrupted("interrupted after " + std::to_string(mapped.frames_mapped) +
                       " scans; their map, poses and report are in " + out.string());
   }
   if (!context.quiet && options.print_summary) {
-    std::printf("%s%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
-                result.interrupted ? "interrupted: " : "", result.frames_mapped, result.wall_s,
-                result.wall_s > 0 ? static_cast<double>(result.frames_mapped) / result.wall_s : 0.0,
-                summary.backend.c_str(), summary.map_chunks, summary.map.shifts,
-                out.string().c_str());
+    std::printf("%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
+                mapped.frames_mapped, mapped.wall_s, mapped.scans_per_s(), mapped.backend.c_str(),
+                mapped.map_chunks, mapped.map.shifts, out.string().c_str());
   }
   return {out, report};
 }

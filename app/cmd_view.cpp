@@ -42,7 +42,7 @@ void run_view(const ViewOptions& options, const CliContext& context) {
   const StopSignal stop_signal("closing the viewer's server");
   std::atomic<bool> served{true};
   std::thread listener([&] { served = server.run(); });
-  while (!StopSignal::requested() && served)
+  while (!stop_signal.requested() && served)
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   server.stop();
   listener.join();

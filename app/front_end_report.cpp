@@ -30,7 +30,7 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool 
             {"registration", timing_json(counts.registration_ms)}}}};
 }
 
-nlohmann::json refine_json(const PipelineResult& run,
+nlohmann::json refine_json(const mapping::PassResult& run,
                            const slam::refine::RefineSettings& settings) {
   const slam::refine::RefineCounts& counts = run.refine;
   std::vector<double> registration_ms, step_m, step_deg;
@@ -61,7 +61,7 @@ nlohmann::json refine_json(const PipelineResult& run,
             {"registration", timing_json(registration_ms)}}}};
 }
 
-nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms) {
+nlohmann::json loops_json(const mapping::LoopOutcome& outcome, double finish_ms) {
   const slam::loops::LoopCounts& counts = outcome.counts;
   nlohmann::json rejected = nlohmann::json::object();
   for (const auto& [reason, count] : counts.rejected) rejected[reason] = count;

@@ -6,8 +6,8 @@
 
 #include <string>
 
+#include "featsense/mapping/pass_result.hpp"
 #include "featsense/slam/odometry/odometry_locator.hpp"
-#include "map_pipeline.hpp"
 
 namespace featsense::app {
 
@@ -19,11 +19,12 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool 
 
 /// The refinement of a run that refined (run.unrefined_poses set): stretches, what was kept
 /// and why, the corrections, the latency in scans and the times.
-nlohmann::json refine_json(const PipelineResult& run, const slam::refine::RefineSettings& settings);
+nlohmann::json refine_json(const mapping::PassResult& run,
+                           const slam::refine::RefineSettings& settings);
 
 /// The loop closure of a run: keyframes, candidates, what was rejected and why, each loop
 /// accepted (the keyframes, their stamps, the fit, the correction it brought, its final
 /// weight), the largest correction of a scan and the times.
-nlohmann::json loops_json(const LoopOutcome& outcome, double finish_ms);
+nlohmann::json loops_json(const mapping::LoopOutcome& outcome, double finish_ms);
 
 }  // namespace featsense::app

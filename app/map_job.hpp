@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli_context.hpp"
+#include "featsense/mapping/recording.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "map_outputs.hpp"
@@ -61,7 +62,7 @@ config::Config map_config(const MapOptions& options, const CliContext& context);
 
 /// Opens the recording again from its start, for the loop closure's second pass; empty where
 /// the input cannot be read twice.
-using SourceReopener = std::function<std::unique_ptr<slam::ScanSource>()>;
+using SourceReopener = mapping::SourceReopener;
 
 /// Maps `source` with `poses` (given poses; nullopt: estimated by the odometry front end) and
 /// `config` (from map_config) into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb,

@@ -2,6 +2,9 @@
 
 #include <sys/resource.h>
 
+#include <map>
+
+#include "featsense/storage/hdf5_chunk_store.hpp"
 #include "timing_stats.hpp"
 
 namespace featsense::app {
@@ -11,23 +14,24 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
-nlohmann::json map_report_json(const MapRunSummary& summary) {
-  const PipelineResult& run = *summary.pipeline;
+nlohmann::json map_report_json(const config::Config& config, const slam::SourceInfo& input,
+                               const mapping::MapResult& result) {
+  const mapping::PassResult& run = result.mapped();
   nlohmann::json report;
-  report["input"] = {{"path", summary.input->path},
-                     {"format", summary.input->format},
-                     {"sensor", summary.input->sensor.name},
-                     {"rows", summary.input->sensor.beams},
-                     {"cols", summary.input->sensor.columns}};
-  report["input"]["times"] = summary.input->times;
+  report["input"] = {{"path", input.path},
+                     {"format", input.format},
+                     {"sensor", input.sensor.name},
+                     {"rows", input.sensor.beams},
+                     {"cols", input.sensor.columns}};
+  report["input"]["times"] = input.times;
   report["frames"] = run.frames_mapped;
   report["frames_read"] = run.frames_read;
   report["frames_skipped"] = {{"without_pose", run.frames_without_pose},
                               {"outside_range", run.frames_outside_range}};
   report["interrupted"] = run.interrupted;
-  report["backend"] = summary.backend;
-  report["backend_reason"] = summary.backend_reason;
-  report["poses"] = summary.poses;
+  report["backend"] = run.backend;
+  report["backend_reason"] = run.backend_reason;
+  report["poses"] = result.poses;
   report["points"] = run.points;
   report["mixed_pixels_dropped"] = run.mixed_pixels_dropped;
   report["voxels_updated"] = run.voxels_updated;
@@ -38,26 +42,43 @@ nlohmann::json map_report_json(const MapRunSummary& summary) {
                        {"shift", timing_json(run.timings.shift_ms)},
                        {"integrate", timing_json(run.timings.integrate_ms)},
                        {"flush", timing_json(run.timings.flush_ms)},
-                       {"final_flush", timing_json(summary.final_flush_ms)}};
+                       {"final_flush", timing_json(run.timings.final_flush_ms)}};
   report["wall_s"] = run.wall_s;
-  report["scans_per_s"] =
-      run.wall_s > 0.0 ? static_cast<double>(run.frames_mapped) / run.wall_s : 0.0;
+  report["scans_per_s"] = run.scans_per_s();
   report["recording_s"] = run.recording_s;
   // Above 1: faster than the sensor recorded.
   report["real_time_factor"] = run.wall_s > 0.0 ? run.recording_s / run.wall_s : 0.0;
   report["peak_rss_mb"] = peak_rss_mb();
-  report["device_memory_mb"] = static_cast<double>(summary.device_memory_bytes) / (1024.0 * 1024.0);
-  report["map"] = {{"chunks", summary.map_chunks},
-                   {"continued_chunks", summary.continued_chunks},
-                   {"shifts", summary.map.shifts},
-                   {"bricks_spilled", summary.map.bricks_spilled},
-                   {"bricks_loaded", summary.map.bricks_loaded},
-                   {"chunks_written", summary.map.chunks_written},
-                   {"chunks_unchanged", summary.map.chunks_unchanged},
-                   {"syncs", summary.map.syncs}};
+  report["device_memory_mb"] = static_cast<double>(run.device_memory_bytes) / (1024.0 * 1024.0);
+  report["map"] = {{"chunks", run.map_chunks},
+                   {"continued_chunks", run.continued_chunks},
+                   {"shifts", run.map.shifts},
+                   {"bricks_spilled", run.map.bricks_spilled},
+                   {"bricks_loaded", run.map.bricks_loaded},
+                   {"chunks_written", run.map.chunks_written},
+                   {"chunks_unchanged", run.map.chunks_unchanged},
+                   {"syncs", run.map.syncs}};
   report["warnings"] = {{"count", run.warning_count}, {"first", run.warnings}};
-  report["config"] = config::to_yaml(*summary.config);
+  report["config"] = config::to_yaml(config);
   return report;
+}
+
+nlohmann::json sessions_json(const std::filesystem::path& path) {
+  const storage::Hdf5ChunkStore store(path);
+  std::map<uint32_t, size_t> keyframes;
+  for (const storage::KeyframeKey& key : store.keyframe_keys()) ++keyframes[key.session];
+  nlohmann::json out = nlohmann::json::array();
+  for (const storage::MapSession& session : store.read_sessions()) {
+    out.push_back({{"id", session.id},
+                   {"input", session.input},
+                   {"format", session.format},
+                   {"scans", session.scans},
+                   {"first_stamp_s", session.first_stamp_s},
+                   {"last_stamp_s", session.last_stamp_s},
+                   {"placement", session.placement},
+                   {"keyframes", keyframes[session.id]}});
+  }
+  return out;
 }
 
 }  // namespace featsense::app

@@ -2,7 +2,10 @@
 
 #include <unistd.h>
 
+#include <spdlog/spdlog.h>
+
 #include <cstdio>
+#include <mutex>
 
 namespace featsense::app {
 
@@ -48,6 +51,52 @@ void Progress::finish() {
     std::fflush(stderr);
     drawn_ = false;
   }
+}
+
+namespace {
+
+/// The progress lines of a run's passes: the callbacks come from one thread at a time.
+class PassProgress {
+ public:
+  explicit PassProgress(bool quiet) : quiet_(quiet) {}
+
+  void update(const mapping::RunProgress& at) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!line_ || at.frames_read < last_read_)
+      line_ = std::make_unique<Progress>("frames", at.total_frames, quiet_);
+    last_read_ = at.frames_read;
+    char text[96];
+    if (at.integrating) {
+      std::snprintf(text, sizeof(text), "%zu mapped, %zu shifts, %zu chunks written",
+                    at.frames_mapped, at.shifts, at.chunks_written);
+    } else {
+      std::snprintf(text, sizeof(text), "%zu placed", at.frames_mapped);
+    }
+    line_->update(at.frames_read, text);
+  }
+
+ private:
+  bool quiet_;
+  std::mutex mutex_;
+  std::unique_ptr<Progress> line_;
+  size_t last_read_ = 0;
+};
+
+}  // namespace
+
+mapping::RunEvents terminal_events(const mapping::StopToken& stop, bool quiet) {
+  mapping::RunEvents events;
+  events.stop = stop;
+  auto progress = std::make_shared<PassProgress>(quiet);
+  events.progress = [progress](const mapping::RunProgress& at) { progress->update(at); };
+  events.log = [](mapping::LogLevel level, const std::string& text) {
+    if (level == mapping::LogLevel::kWarning) {
+      spdlog::warn("{}", text);
+    } else {
+      spdlog::info("{}", text);
+    }
+  };
+  return events;
 }
 
 }  // namespace featsense::app

@@ -3,8 +3,11 @@
 // quiet or when stderr is not a terminal (logs and CI stay clean).
 
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <string>
+
+#include "featsense/mapping/run_events.hpp"
 
 namespace featsense::app {
 
@@ -30,5 +33,10 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };
+
+/// A mapping run's events as the command line shows them: a progress line per pass (a pass
+/// that starts again from its first scan gets a new line), messages through the log, and
+/// `stop` (a StopSignal's token) as the run's stop token.
+mapping::RunEvents terminal_events(const mapping::StopToken& stop, bool quiet);
 
 }  // namespace featsense::app

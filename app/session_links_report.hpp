@@ -1,20 +1,24 @@
 #pragma once
-// The `links` section of a continued run's or a merge's report: how many links joined the
-// sessions, between which, what was tried and rejected, and each link by name (which keyframe
-// of which session saw which, its fit, its final weight in the graph and how far it moved the
-// later session when it was accepted), so that a user can see where the sessions were joined.
+// The relocalization and the links between sessions as report.json writes them: where a
+// recording was placed in a saved map and by which keyframes, each link between two
+// sessions' keyframes (which keyframes, where the linked graph put them, the fit, the final
+// weight and how far the link moved the session when it was found), and what became of the
+// map's earlier sessions (`featsense map --continue` and `featsense merge`).
 
 #include <nlohmann/json.hpp>
 
-#include <vector>
-
-#include "featsense/slam/loops/map_keyframe.hpp"
-#include "featsense/slam/loops/session_links.hpp"
+#include "featsense/mapping/relocalization_report.hpp"
+#include "featsense/mapping/session_remap.hpp"
+#include "featsense/slam/loops/relocalizer.hpp"
 
 namespace featsense::app {
 
-/// `keyframes`: those given to link_sessions, in the same order.
-nlohmann::json session_links_json(const slam::loops::SessionLinkResult& linked,
-                                  const std::vector<slam::loops::MapKeyframe>& keyframes);
+nlohmann::json session_links_json(const mapping::SessionLinks& links);
+
+/// What placing tried: keyframes, candidates, verified, rejections by reason, times.
+nlohmann::json tried_json(const slam::loops::RelocalizationCounts& counts);
+
+/// report.json's "relocalization" of `featsense map --continue`.
+nlohmann::json relocalization_json(const mapping::RelocalizationReport& report);
 
 }  // namespace featsense::app

@@ -1,8 +1,6 @@
 #include "source_options.hpp"
 
-#include "featsense/config/sensor_model.hpp"
-#include "featsense/slam/io/open_scan_source.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/mapping/recording.hpp"
 
 namespace featsense::app {
 
@@ -26,28 +24,7 @@ void InputOptions::add_to(CLI::App& command, bool input_optional) {
 }
 
 std::unique_ptr<slam::ScanSource> InputOptions::open(const config::Config& config) const {
-  if (input.empty()) {
-    slam::BoxRoomSettings settings = slam::default_box_room();
-    if (config.sensor.preset != "auto") {
-      settings.sensor = config::sensor_preset(config.sensor.preset);
-    }
-    return slam::with_range_limits(slam::make_box_room_source(settings),
-                                   config.sensor.min_range_m.value_or(settings.sensor.min_range_m),
-                                   config.sensor.max_range_m.value_or(settings.sensor.max_range_m));
-  }
-  slam::SourceOptions options;
-  options.meta_path = meta_path;
-  options.topic = topic;
-  options.sensor_preset = config.sensor.preset;
-  options.min_range_m = config.sensor.min_range_m;
-  options.max_range_m = config.sensor.max_range_m;
-  options.times_from_azimuth = config.sensor.times_from_azimuth;
-  options.velodyne_calibration = config.sensor.calibration;
-  options.scan_cut_deg = config.sensor.scan_cut_deg;
-  options.imu = config.sensor.imu;
-  options.imu_topic = config.sensor.imu_topic;
-  options.imu_rotation_deg = config.sensor.imu_rotation_deg;
-  return slam::open_scan_source(input, options);
+  return mapping::open_recording(input, config, meta_path, topic);
 }
 
 }  // namespace featsense::app

@@ -13,12 +13,14 @@ std::atomic<int> g_signals{0};
 // Set before the handlers are installed, read in the handler.
 const char* g_message = "";
 std::size_t g_message_length = 0;
+const mapping::StopToken* g_token = nullptr;
 struct sigaction g_old_int {};
 struct sigaction g_old_term {};
 
 extern "C" void on_stop_signal(int) {
-  // Only async-signal-safe calls here: an atomic counter, write(2) and _exit(2).
+  // Only async-signal-safe calls here: atomics (the token's is lock-free), write(2), _exit(2).
   if (g_signals.fetch_add(1) == 0) {
+    if (g_token) g_token->request_stop();
     static const char kFirst[] = "\nfeatsense: stopping: ";
     [[maybe_unused]] ssize_t n = ::write(STDERR_FILENO, kFirst, sizeof(kFirst) - 1);
     n = ::write(STDERR_FILENO, g_message, g_message_length);
@@ -33,9 +35,11 @@ extern "C" void on_stop_signal(int) {
 }  // namespace
 
 StopSignal::StopSignal(const char* message) {
+  static_assert(std::atomic<bool>::is_always_lock_free, "the stop flag is set in a handler");
   g_signals.store(0);
   g_message = message;
   g_message_length = std::strlen(message);
+  g_token = &token_;
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
@@ -47,8 +51,7 @@ StopSignal::StopSignal(const char* message) {
 StopSignal::~StopSignal() {
   sigaction(SIGINT, &g_old_int, nullptr);
   sigaction(SIGTERM, &g_old_term, nullptr);
+  g_token = nullptr;
 }
-
-bool StopSignal::requested() { return g_signals.load() > 0; }
 
 }  // namespace featsense::app

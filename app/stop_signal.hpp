@@ -1,18 +1,14 @@
 #pragma once
-// Ctrl+C and SIGTERM during a long run: the first asks the run to stop (it finishes the
-// scans in flight, writes the map and the report); the second exits at once, leaving the
-// store as a crash would (readable up to its last flush).
+// Ctrl+C and SIGTERM during a long run: the first requests a stop on the run's stop token (the
+// run finishes the scans in flight, writes the map and the report); the second exits at once,
+// leaving the store as a crash would (readable up to its last flush).
 
-#include <stdexcept>
+#include "featsense/mapping/stop_token.hpp"
 
 namespace featsense::app {
 
-/// A run that a signal stopped after writing what it had: the program exits with 130, as a
-/// shell reports a process that SIGINT ended.
-class Interrupted : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+/// A run that a signal stopped after writing what it had: the program exits with 130.
+using Interrupted = mapping::Interrupted;
 
 class StopSignal {
  public:
@@ -21,14 +17,20 @@ class StopSignal {
       "finishing the scans in flight and writing the map (press Ctrl+C again to quit at once)";
 
   /// Installs the handlers for SIGINT and SIGTERM; the destructor restores the old ones. The
-  /// first signal prints "featsense: stopping: `message`" (a static string).
+  /// first signal prints "featsense: stopping: `message`" (a static string) and requests a
+  /// stop on token().
   explicit StopSignal(const char* message = kMapMessage);
   ~StopSignal();
   StopSignal(const StopSignal&) = delete;
   StopSignal& operator=(const StopSignal&) = delete;
 
+  /// The token a signal sets: hand it to the run (RunEvents::stop).
+  const mapping::StopToken& token() const { return token_; }
   /// True once SIGINT or SIGTERM arrived.
-  static bool requested();
+  bool requested() const { return token_.stop_requested(); }
+
+ private:
+  mapping::StopToken token_;
 };
 
 }  // namespace featsense::app

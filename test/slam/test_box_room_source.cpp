@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 
 namespace featsense::slam {
 namespace {

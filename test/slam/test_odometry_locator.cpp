@@ -6,7 +6,7 @@
 
 #include "featsense/config/config.hpp"
 #include "featsense/slam/odometry/odometry_locator.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 
 namespace featsense::slam::odometry {
 namespace {

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "analytic_rays.hpp"
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
 
 namespace featsense::tsdf::test {

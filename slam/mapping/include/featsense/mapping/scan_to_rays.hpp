@@ -8,9 +8,9 @@
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 /// Every valid point of `scan` as a ray in the map frame, row by row.
 tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const slam::ScanPlacement& placement);
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

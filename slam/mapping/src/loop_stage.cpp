@@ -1,11 +1,11 @@
-#include "loop_stage.hpp"
+#include "featsense/mapping/loop_stage.hpp"
 
 #include <algorithm>
 #include <chrono>
 
 #include "featsense/slam/refine/refinement_cloud.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 namespace {
 
 /// Keyframes waiting for the loop thread: enough to ride out one verification that takes
@@ -105,4 +105,4 @@ LoopOutcome LoopStage::finish() {
   return out;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

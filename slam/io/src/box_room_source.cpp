@@ -1,4 +1,4 @@
-#include "featsense/slam/sim/box_room_source.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 
 #include <cmath>
 #include <limits>

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "scan_to_rays.hpp"
+#include "featsense/mapping/scan_to_rays.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 namespace {
 
 /// One column of `rows` beams 0.35 deg apart (row 0 highest, at +2 deg) hitting `surface`.
@@ -143,4 +143,4 @@ TEST(ScanToRays, APlacementWithTheWrongNumberOfColumnPosesIsRefused) {
 }
 
 }  // namespace
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,14 +1,14 @@
-#include "saved_map.hpp"
+#include "featsense/mapping/saved_map.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
 
+#include "featsense/mapping/map_store.hpp"
 #include "featsense/slam/loops/trajectory_correction.hpp"
-#include "map_store.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 slam::loops::MapKeyframe map_keyframe(const storage::StoredKeyframe& stored) {
   slam::loops::MapKeyframe out;
@@ -121,4 +121,4 @@ SavedMap read_saved_map(const std::filesystem::path& path) {
   return out;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -12,14 +12,14 @@
 #include <thread>
 #include <vector>
 
-#include "bounded_queue.hpp"
+#include "featsense/mapping/bounded_queue.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/loops/relocalizer.hpp"
 #include "featsense/slam/scan.hpp"
 #include "featsense/slam/scan_locator.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 struct LoopOutcome {
   std::vector<slam::loops::LoopRecord> loops;
@@ -98,4 +98,4 @@ class LoopStage {
   std::thread worker_;  ///< last: it starts once everything it uses is there
 };
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,4 +1,4 @@
-#include "scan_to_rays.hpp"
+#include "featsense/mapping/scan_to_rays.hpp"
 
 #include <stdexcept>
 #include <string>
@@ -6,7 +6,7 @@
 
 #include "featsense/tsdf/scan_rays.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 namespace {
 
 tsdf::Vec3 to_vec(const Eigen::Vector3d& p) {
@@ -60,4 +60,4 @@ tsdf::RayBatch scan_to_rays(const slam::Scan& scan, const slam::ScanPlacement& p
   return rays;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,15 +1,13 @@
-#include "map_store.hpp"
-
-#include <spdlog/spdlog.h>
+#include "featsense/mapping/map_store.hpp"
 
 #include <charconv>
 #include <cmath>
 
 #include "featsense/config/config_error.hpp"
+#include "featsense/mapping/map_sessions.hpp"
 #include "featsense/storage/vdb_io.hpp"
-#include "map_sessions.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 namespace {
 
 namespace fs = std::filesystem;
@@ -61,7 +59,7 @@ slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& po
 }
 
 void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
-                        config::Config& config) {
+                        config::Config& config, const RunEvents& events) {
   const auto adopt = [&](const std::string& key, double& value, double old_value) {
     const auto given = config.explicit_keys.find(key);
     if (given != config.explicit_keys.end() && !same(value, old_value)) {
@@ -71,7 +69,7 @@ void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& 
                                 " unset to continue it");
     }
     if (!same(value, old_value)) {
-      spdlog::info("{} = {} of the continued map {}", key, metres(old_value), what);
+      events.info(key + " = " + metres(old_value) + " of the continued map " + what);
     }
     value = old_value;
   };
@@ -121,7 +119,8 @@ std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& traj
 
 MapStore open_map_store(const fs::path& path, config::Config& config,
                         const std::string& sensor_name,
-                        const std::optional<std::string>& continue_from, bool overwrite) {
+                        const std::optional<std::string>& continue_from, bool overwrite,
+                        const RunEvents& events) {
   MapStore result;
   const storage::OpenMode create =
       overwrite ? storage::OpenMode::kCreateOverwrite : storage::OpenMode::kCreate;
@@ -141,7 +140,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   const bool in_place = fs::exists(path) && fs::equivalent(old_path, path);
   if (old_path.extension() == ".vdb") {
     // A .vdb carries voxel size and tau; the rest of the metadata comes from this run.
-    adopt_map_geometry(storage::read_vdb_metadata(old_path), old_path.string(), config);
+    adopt_map_geometry(storage::read_vdb_metadata(old_path), old_path.string(), config, events);
     result.store =
         std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
     result.continued_chunks = storage::import_vdb(old_path, *result.store).chunks;
@@ -149,7 +148,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   }
   if (in_place) {
     storage::Hdf5ChunkStore probe(old_path);
-    adopt_map_geometry(probe.metadata(), old_path.string(), config);
+    adopt_map_geometry(probe.metadata(), old_path.string(), config, events);
     result.earlier_poses = from_store_poses(probe.read_trajectory());
     result.continued_chunks = probe.keys().size();
     probe.close();
@@ -161,7 +160,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
     throw std::runtime_error(path.string() + " exists; pass --overwrite to replace it");
   }
   storage::Hdf5ChunkStore old_map(old_path);
-  adopt_map_geometry(old_map.metadata(), old_path.string(), config);
+  adopt_map_geometry(old_map.metadata(), old_path.string(), config, events);
   result.earlier_poses = from_store_poses(old_map.read_trajectory());
   result.store =
       std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
@@ -170,4 +169,4 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   return result;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

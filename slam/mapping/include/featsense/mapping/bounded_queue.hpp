@@ -8,7 +8,7 @@
 #include <mutex>
 #include <optional>
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 template <typename T>
 class BoundedQueue {
@@ -62,4 +62,4 @@ class BoundedQueue {
   bool closed_ = false;
 };
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,10 +1,8 @@
 #pragma once
-// What `map` records of itself in the map file: the run as a session (its input, its scans,
+// What a mapping run records of itself in the map file: the run as a session (its input, its scans,
 // how its poses were placed) and the keyframes of its loop closure at their final poses, in
 // the map frame, so that a later recording can be placed in the map by them
 // (storage/FORMAT.md, /sessions and /keyframes).
-
-#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -15,7 +13,7 @@
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 struct SessionDescription {
   std::string input;      ///< the recording, as given
@@ -30,12 +28,8 @@ uint32_t record_session(storage::Hdf5ChunkStore& store, const SessionDescription
                         const slam::Trajectory& poses,
                         const std::vector<slam::loops::KeyframeRecord>& keyframes);
 
-/// The sessions of the map at `path` for the report: each with its input, format, scans,
-/// stamps, placement and the number of keyframes it keeps.
-nlohmann::json sessions_json(const std::filesystem::path& path);
-
 /// The sessions and keyframes of `from` into `to`, one keyframe at a time (a map continued
 /// into another file keeps them).
 void copy_sessions(const storage::Hdf5ChunkStore& from, storage::Hdf5ChunkStore& to);
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,5 +1,5 @@
 #pragma once
-// The store of a `featsense map` run: a new OUT/map.h5, or one that continues an existing
+// The store of a mapping run: a new OUT/map.h5, or one that continues an existing
 // map (.h5 or .vdb), whose voxel size and tau then win over the configuration.
 
 #include <filesystem>
@@ -9,10 +9,11 @@
 #include <string>
 
 #include "featsense/config/config.hpp"
+#include "featsense/mapping/run_events.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 struct MapStore {
   std::unique_ptr<storage::Hdf5ChunkStore> store;
@@ -27,13 +28,14 @@ struct MapStore {
 /// default included, is a ConfigError naming both.
 MapStore open_map_store(const std::filesystem::path& path, config::Config& config,
                         const std::string& sensor_name,
-                        const std::optional<std::string>& continue_from, bool overwrite);
+                        const std::optional<std::string>& continue_from, bool overwrite,
+                        const RunEvents& events = {});
 
 /// The old map's voxel size and tau (`what` names it) win over values that were not set; a
 /// value set explicitly (config file, --set or an option), even to the default, must be the
 /// old map's, else ConfigError naming both.
 void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
-                        config::Config& config);
+                        config::Config& config, const RunEvents& events = {});
 
 /// The trajectory of a store's poses.
 slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses);
@@ -47,4 +49,4 @@ void build_then_replace(const std::filesystem::path& partial, const std::filesys
 /// The store's trajectory form of `trajectory`.
 std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& trajectory);
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

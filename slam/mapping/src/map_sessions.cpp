@@ -1,12 +1,11 @@
-#include "map_sessions.hpp"
+#include "featsense/mapping/map_sessions.hpp"
 
 #include <algorithm>
-#include <map>
 #include <stdexcept>
 
-#include "map_store.hpp"
+#include "featsense/mapping/map_store.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 namespace {
 
 /// Keyframes written between two flushes: each is held in memory until a flush.
@@ -62,24 +61,6 @@ uint32_t record_session(storage::Hdf5ChunkStore& store, const SessionDescription
   return id;
 }
 
-nlohmann::json sessions_json(const std::filesystem::path& path) {
-  const storage::Hdf5ChunkStore store(path);
-  std::map<uint32_t, size_t> keyframes;
-  for (const storage::KeyframeKey& key : store.keyframe_keys()) ++keyframes[key.session];
-  nlohmann::json out = nlohmann::json::array();
-  for (const storage::MapSession& session : store.read_sessions()) {
-    out.push_back({{"id", session.id},
-                   {"input", session.input},
-                   {"format", session.format},
-                   {"scans", session.scans},
-                   {"first_stamp_s", session.first_stamp_s},
-                   {"last_stamp_s", session.last_stamp_s},
-                   {"placement", session.placement},
-                   {"keyframes", keyframes[session.id]}});
-  }
-  return out;
-}
-
 void copy_sessions(const storage::Hdf5ChunkStore& from, storage::Hdf5ChunkStore& to) {
   const std::vector<storage::MapSession> sessions = from.read_sessions();
   if (!sessions.empty()) to.write_sessions(sessions);
@@ -92,4 +73,4 @@ void copy_sessions(const storage::Hdf5ChunkStore& from, storage::Hdf5ChunkStore&
   }
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

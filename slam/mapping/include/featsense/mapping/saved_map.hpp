@@ -14,7 +14,7 @@
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 
-namespace featsense::app {
+namespace featsense::mapping {
 
 struct SavedSession {
   storage::MapSession session;
@@ -57,4 +57,4 @@ slam::Trajectory moved_path(const slam::Trajectory& path,
                             const std::vector<slam::loops::MapKeyframe>& keyframes, size_t first,
                             size_t end, const std::vector<Eigen::Isometry3d>& after);
 
-}  // namespace featsense::app
+}  // namespace featsense::mapping

@@ -1,0 +1,149 @@
+#pragma once
+// One pass over a recording: each scan placed by the front end (given poses or odometry),
+// its pose refined, offered to the loop closure, turned into rays and integrated into the
+// TSDF map, which spills into the store. Each stage is a method of its own so that the
+// threaded pipeline (map_pipeline.hpp) runs them in threads joined by bounded queues and the
+// synchronous Mapper::add_scan one after the other: both make the same map. Every stage is
+// called from one thread only (its own), in scan order.
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/config/config.hpp"
+#include "featsense/mapping/loop_stage.hpp"
+#include "featsense/mapping/map_sessions.hpp"
+#include "featsense/mapping/pass_result.hpp"
+#include "featsense/mapping/run_events.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/refine/placement_refiner.hpp"
+#include "featsense/slam/scan.hpp"
+#include "featsense/slam/scan_locator.hpp"
+#include "featsense/slam/scan_source.hpp"
+#include "featsense/tsdf/ray_batch.hpp"
+
+namespace featsense::mapping {
+
+/// Where a pass writes: a new map file (replaced with `overwrite`), or a copy of a map being
+/// continued (in place where it is the same file).
+struct MapStoreRequest {
+  std::filesystem::path path;
+  std::string sensor_name;
+  std::optional<std::string> continue_from;
+  bool overwrite = false;
+  /// The run as the map's new session (map_sessions.hpp).
+  SessionDescription session;
+  /// The keyframes the session keeps; null: those of this pass's loop closure, where it ran.
+  const std::vector<slam::loops::KeyframeRecord>* keyframes = nullptr;
+};
+
+/// What a pass does with each scan besides placing it.
+struct PassSettings {
+  double flush_interval_s = config::MapConfig{}.flush_interval_s;  ///< map.flush_interval
+  bool drop_mixed_pixels = true;                                   ///< sensor.drop_mixed_pixels
+  /// Refine the locator's poses before they are mapped (refine.*; for odometry).
+  std::optional<slam::refine::RefineSettings> refine;
+  /// Close loops over the final poses (loop.*; for odometry): keyframes, verification, the
+  /// pose graph in a thread of their own; the corrected poses come with the result.
+  std::optional<slam::loops::LoopSettings> loops;
+  /// With loops: place the run in a saved map as its keyframes come.
+  std::optional<RelocalizeStage> relocalize;
+  /// False: the poses only, nothing integrated and no store opened.
+  bool integrate = true;
+};
+
+/// A scan with its place, on its way to becoming rays.
+struct PlacedScan {
+  slam::Scan scan;
+  slam::ScanPlacement placement;
+};
+
+/// A placed scan as rays in the map frame: what the mapping stage integrates.
+struct LocatedScan {
+  slam::ScanPlacement placement;
+  tsdf::RayBatch rays;
+};
+
+class MapPass {
+ public:
+  /// Opens the store of `store` (not with settings.integrate false); `config` takes a
+  /// continued map's voxel size and tau. `sensor` gives the TSDF its beams (vertical
+  /// interpolation). `locator` must outlive the pass.
+  MapPass(slam::ScanLocator& locator, const PassSettings& settings, config::Config& config,
+          const config::SensorModel& sensor, const MapStoreRequest& store, RunEvents events);
+  ~MapPass();
+  MapPass(const MapPass&) = delete;
+  MapPass& operator=(const MapPass&) = delete;
+
+  /// The reader's stage: every scan the source handed out is counted; one before the range
+  /// to map is counted apart, one that goes on to be mapped with the time it took to read.
+  void count_read() { frames_read_.fetch_add(1); }
+  void count_before_range() { ++result_.frames_outside_range; }
+  void add_read_time(double read_ms) { result_.timings.read_ms.push_back(read_ms); }
+  /// Whether the pass holds scans for a refinement (the pipeline gives it a thread).
+  bool refines() const { return refiner_ != nullptr; }
+  /// The recording's scans, where known: for the progress only.
+  void set_total_frames(std::optional<size_t> frames) { total_frames_ = frames; }
+  bool stop_requested() const { return events_.stop.stop_requested(); }
+
+  /// The front end: mixed pixels dropped, the scan placed. Nullopt: skipped (counted, warned).
+  std::optional<PlacedScan> locate(slam::Scan scan, std::string* why = nullptr);
+  /// The refinement: the scans whose poses became final, in order (at once without it).
+  std::vector<PlacedScan> refine(PlacedScan placed);
+  /// The end of the input (or a stop): the last stretch refined (nothing the second time).
+  std::vector<PlacedScan> finish_refinement();
+  /// The loop closure sees the scan; its rays are made. Nullopt: the run stops (the
+  /// relocalization gave up, or the loop thread was abandoned).
+  std::optional<LocatedScan> make_rays(PlacedScan placed);
+  /// Integrated into the map (the local map follows the sensor; flushed every
+  /// flush_interval_s), or, without a map, its pose kept.
+  void integrate(LocatedScan located);
+
+  /// The source's warnings, after the pass's own.
+  void add_source_warnings(const slam::ReadStats& read);
+
+  /// A failure somewhere: the loop thread is stopped and what was integrated is flushed.
+  /// Never throws.
+  void abandon();
+  /// The end: the loop closure finishes, the map is flushed, the poses and the session go
+  /// into the store. Call once, after every stage is done.
+  PassResult close();
+
+  /// Results of the stages so far; read only from the thread that calls integrate().
+  const PassResult& result() const { return result_; }
+
+ private:
+  void warn(const std::string& message);
+  void open_map(const LocatedScan& first);
+  void report_progress();
+  std::vector<PlacedScan> release(std::vector<slam::ScanPlacement> final);
+  void write_store();
+
+  slam::ScanLocator& locator_;
+  PassSettings settings_;
+  config::Config& config_;
+  config::SensorModel sensor_;
+  MapStoreRequest request_;
+  RunEvents events_;
+  PassResult result_;
+  std::mutex warnings_mutex_;
+  std::atomic<size_t> frames_read_{0};
+  std::unique_ptr<slam::refine::PlacementRefiner> refiner_;
+  std::deque<PlacedScan> held_;  ///< scans waiting for their final pose, in order
+  bool refinement_finished_ = false;
+  std::unique_ptr<LoopStage> loops_;
+  struct Store;
+  std::unique_ptr<Store> store_;
+  std::optional<size_t> total_frames_;
+  std::chrono::steady_clock::time_point started_;
+  std::chrono::steady_clock::time_point last_flush_;
+  bool closed_ = false;
+};
+
+}  // namespace featsense::mapping

@@ -1,0 +1,188 @@
+#include "featsense/mapping/map_pipeline.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include "featsense/mapping/bounded_queue.hpp"
+
+namespace featsense::mapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// What the stages share: the first error and whether to stop.
+class PipelineState {
+ public:
+  explicit PipelineState(const MapPass& pass) : pass_(pass) {}
+  bool failed() const { return failed_.load(); }
+  bool stopping() const { return failed() || pass_.stop_requested(); }
+
+  void fail(std::exception_ptr error) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!error_) error_ = error;
+    failed_.store(true);
+  }
+  std::exception_ptr failure() const { return error_; }
+
+ private:
+  const MapPass& pass_;
+  std::mutex mutex_;
+  std::atomic<bool> failed_{false};
+  std::exception_ptr error_;
+};
+
+/// Runs `work` and turns an exception into a pipeline failure that stops every stage.
+template <typename Work>
+void guarded(PipelineState& state, const Work& work) {
+  try {
+    work();
+  } catch (...) {
+    state.fail(std::current_exception());
+  }
+}
+
+bool before_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
+  if (range.first_frame && scan.sequence < *range.first_frame) return true;
+  if (range.first_stamp_ns && scan.stamp_ns < *range.first_stamp_ns) return true;
+  return range.first_s &&
+         static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 < *range.first_s;
+}
+
+bool after_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
+  if (range.last_frame && scan.sequence > *range.last_frame) return true;
+  if (range.last_stamp_ns && scan.stamp_ns > *range.last_stamp_ns) return true;
+  return range.last_s && static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 > *range.last_s;
+}
+
+void read_scans(slam::ScanSource& source, const FrameRange& range, MapPass& pass,
+                BoundedQueue<slam::Scan>& out, const PipelineState& state) {
+  std::optional<int64_t> first_stamp_ns;
+  while (!state.stopping()) {
+    const Clock::time_point start = Clock::now();
+    std::optional<slam::Scan> scan = source.next();
+    if (!scan) break;
+    pass.count_read();
+    if (!first_stamp_ns) first_stamp_ns = scan->stamp_ns;
+    if (after_range(*scan, range, *first_stamp_ns)) break;
+    if (before_range(*scan, range, *first_stamp_ns)) {
+      pass.count_before_range();
+      continue;
+    }
+    pass.add_read_time(ms_since(start));
+    if (!out.push(std::move(*scan))) break;
+  }
+}
+
+void locate_scans(MapPass& pass, BoundedQueue<slam::Scan>& in, BoundedQueue<PlacedScan>& out) {
+  while (std::optional<slam::Scan> scan = in.pop()) {
+    std::optional<PlacedScan> placed = pass.locate(std::move(*scan));
+    if (placed && !out.push(std::move(*placed))) break;
+  }
+}
+
+bool push_all(std::vector<PlacedScan> scans, BoundedQueue<PlacedScan>& out) {
+  for (PlacedScan& scan : scans) {
+    if (!out.push(std::move(scan))) return false;
+  }
+  return true;
+}
+
+/// The refinement holds each stretch's scans until their poses are final; the queue before
+/// it is deep enough that the odometry does not wait while a stretch is registered.
+void refine_scans(MapPass& pass, BoundedQueue<PlacedScan>& in, BoundedQueue<PlacedScan>& out) {
+  while (std::optional<PlacedScan> placed = in.pop()) {
+    if (!push_all(pass.refine(std::move(*placed)), out)) break;
+  }
+  // The end of the input, or a stop: the last stretch is refined and mapped too.
+  push_all(pass.finish_refinement(), out);
+}
+
+/// Rays in a stage of their own: with odometry the front end is the pipeline's slowest
+/// stage, and the deskewing of every point need not wait for it. The poses are final here:
+/// the loop closure sees each scan too.
+void make_rays(MapPass& pass, BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out) {
+  while (std::optional<PlacedScan> placed = in.pop()) {
+    std::optional<LocatedScan> located = pass.make_rays(std::move(*placed));
+    if (!located || !out.push(std::move(*located))) break;
+  }
+}
+
+void integrate_scans(MapPass& pass, BoundedQueue<LocatedScan>& in) {
+  while (std::optional<LocatedScan> scan = in.pop()) pass.integrate(std::move(*scan));
+}
+
+}  // namespace
+
+void drive_pass(slam::ScanSource& source, MapPass& pass, const PipelineSettings& settings) {
+  pass.set_total_frames(source.info().frames);
+  PipelineState state(pass);
+  BoundedQueue<slam::Scan> scans(settings.queue_capacity);
+  // Before a refinement the odometry runs ahead while a stretch is registered: a deeper queue.
+  BoundedQueue<PlacedScan> placed(pass.refines() ? 4 * settings.queue_capacity
+                                                 : settings.queue_capacity);
+  BoundedQueue<PlacedScan> refined(settings.queue_capacity);
+  BoundedQueue<LocatedScan> located(settings.queue_capacity);
+
+  // Each stage closes its output when it ends, so the next one drains and ends too; a
+  // failing stage abandons its input so the one before it cannot block on a full queue.
+  std::thread reader([&] {
+    guarded(state, [&] { read_scans(source, settings.range, pass, scans, state); });
+    scans.close();
+  });
+  std::thread front_end([&] {
+    guarded(state, [&] { locate_scans(pass, scans, placed); });
+    if (state.stopping()) scans.abandon();
+    placed.close();
+  });
+  std::thread refinement;
+  if (pass.refines()) {
+    refinement = std::thread([&] {
+      guarded(state, [&] { refine_scans(pass, placed, refined); });
+      if (state.stopping()) placed.abandon();
+      refined.close();
+    });
+  }
+  BoundedQueue<PlacedScan>& to_rays = pass.refines() ? refined : placed;
+  std::thread rays([&] {
+    guarded(state, [&] { make_rays(pass, to_rays, located); });
+    if (state.stopping()) to_rays.abandon();
+    located.close();
+  });
+  guarded(state, [&] { integrate_scans(pass, located); });
+  located.abandon();
+  refined.abandon();
+  placed.abandon();
+  scans.abandon();
+  rays.join();
+  if (refinement.joinable()) refinement.join();
+  front_end.join();
+  reader.join();
+  if (state.failed()) {
+    pass.abandon();
+    std::rethrow_exception(state.failure());
+  }
+  pass.add_source_warnings(source.stats());
+}
+
+PassResult run_pipeline(slam::ScanSource& source, MapPass& pass, const PipelineSettings& settings) {
+  drive_pass(source, pass, settings);
+  return pass.close();
+}
+
+PassResult run_pass(slam::ScanSource& source, slam::ScanLocator& locator,
+                    const PassSettings& settings, config::Config& config,
+                    const MapStoreRequest& store, const RunEvents& events,
+                    const PipelineSettings& pipeline) {
+  MapPass pass(locator, settings, config, source.info().sensor, store, events);
+  return run_pipeline(source, pass, pipeline);
+}
+
+}  // namespace featsense::mapping

@@ -1,0 +1,165 @@
+// The threaded pipeline and the synchronous Mapper over the same stages: the same map either
+// way, a stop token that ends a run with its map written, and a stage's failure that stops
+// every thread and comes back as the error.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+
+#include "common/test_data.hpp"
+#include "featsense/mapping/map_pipeline.hpp"
+#include "featsense/mapping/mapper.hpp"
+#include "featsense/slam/trajectory/given_pose_locator.hpp"
+#include "mapping/mapping_test_scenes.hpp"
+
+namespace featsense::mapping {
+namespace {
+
+using test::read_chunks;
+using test::room_mapper_settings;
+using test::small_room;
+
+/// A source that hands out another's scans and calls `on_scan(k)` before the k-th.
+class WatchedSource : public slam::ScanSource {
+ public:
+  WatchedSource(std::unique_ptr<slam::ScanSource> inner, std::function<void(size_t)> on_scan)
+      : inner_(std::move(inner)), on_scan_(std::move(on_scan)) {}
+  std::optional<slam::Scan> next() override {
+    on_scan_(handed_out_++);
+    return inner_->next();
+  }
+  const slam::SourceInfo& info() const override { return inner_->info(); }
+
+ private:
+  std::unique_ptr<slam::ScanSource> inner_;
+  std::function<void(size_t)> on_scan_;
+  size_t handed_out_ = 0;
+};
+
+/// A locator that places scans as the true path does, and throws at scan `fail_at`.
+class FailingLocator : public slam::ScanLocator {
+ public:
+  FailingLocator(slam::Trajectory path, uint64_t fail_at)
+      : inner_(slam::make_given_pose_locator(std::move(path), true)), fail_at_(fail_at) {}
+  std::optional<slam::ScanPlacement> locate(const slam::Scan& scan, std::string& why) override {
+    if (scan.sequence == fail_at_) throw std::runtime_error("locator broke at scan 5");
+    return inner_->locate(scan, why);
+  }
+  std::string description() const override { return "failing"; }
+
+ private:
+  std::unique_ptr<slam::ScanLocator> inner_;
+  uint64_t fail_at_;
+};
+
+TEST(MapPipeline, MakesTheSameMapAsAddingTheScansOneByOne) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_same_map");
+  const slam::BoxRoomSettings room = small_room();
+
+  Mapper threaded(room_mapper_settings(room, dir / "threaded.h5"));
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  const MapResult by_pipeline = map_source(*source, threaded);
+
+  Mapper one_by_one(room_mapper_settings(room, dir / "synchronous.h5"));
+  const std::unique_ptr<slam::ScanSource> again = slam::make_box_room_source(room);
+  size_t mapped = 0;
+  while (std::optional<slam::Scan> scan = again->next()) {
+    const ScanUpdate update = one_by_one.add_scan(std::move(*scan));
+    EXPECT_TRUE(update.placed) << update.why;
+    EXPECT_EQ(update.scans_mapped, ++mapped) << "given poses are final at once";
+  }
+  const MapResult by_hand = one_by_one.finish();
+
+  EXPECT_EQ(by_pipeline.mapped().frames_mapped, 12u);
+  EXPECT_EQ(by_hand.mapped().frames_mapped, 12u);
+  EXPECT_EQ(by_pipeline.final_poses.stamps_ns, by_hand.final_poses.stamps_ns);
+  const auto threaded_chunks = read_chunks(dir / "threaded.h5");
+  ASSERT_GT(threaded_chunks.size(), 10u);
+  EXPECT_TRUE(threaded_chunks == read_chunks(dir / "synchronous.h5"))
+      << "the pipeline and add_scan made different maps";
+  EXPECT_EQ(by_pipeline.second_pass.kind, SecondPass::kNotNeeded);
+  EXPECT_EQ(by_pipeline.loops_off_because, "the poses are given");
+}
+
+TEST(MapPipeline, AStopTokenEndsTheRunWithItsMapWritten) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_stop");
+  const slam::BoxRoomSettings room = small_room(40);
+  RunEvents events;
+  const StopToken stop = events.stop;
+  Mapper mapper(room_mapper_settings(room, dir / "map.h5"), events);
+  WatchedSource source(slam::make_box_room_source(room), [&](size_t k) {
+    if (k == 6) stop.request_stop();
+  });
+  const MapResult result = map_source(source, mapper);
+  EXPECT_TRUE(result.mapped().interrupted);
+  EXPECT_GE(result.mapped().frames_mapped, 1u);
+  EXPECT_LT(result.mapped().frames_mapped, 40u);
+  // What was integrated is in the store, with the poses of the scans mapped.
+  EXPECT_FALSE(read_chunks(dir / "map.h5").empty());
+  storage::Hdf5ChunkStore store(dir / "map.h5");
+  EXPECT_EQ(store.read_trajectory().size(), result.mapped().frames_mapped);
+}
+
+TEST(MapPipeline, AFailingStageStopsEveryThreadAndItsErrorComesBack) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_failure");
+  const slam::BoxRoomSettings room = small_room(30);
+  config::Config config = test::small_map_config();
+  FailingLocator locator(test::room_path(room), 5);
+  PassSettings settings;
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  MapPass pass(locator, settings, config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, {});
+  try {
+    run_pipeline(*source, pass);
+    FAIL() << "the pipeline hid the locator's failure";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "locator broke at scan 5");
+  }
+  // The scans before the failure were integrated and flushed: the file is readable.
+  EXPECT_FALSE(read_chunks(dir / "map.h5").empty());
+}
+
+TEST(MapPipeline, ASourceThatFailsComesBackAsItsError) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_source_failure");
+  const slam::BoxRoomSettings room = small_room(20);
+  Mapper mapper(room_mapper_settings(room, dir / "map.h5"));
+  WatchedSource source(slam::make_box_room_source(room), [](size_t k) {
+    if (k == 3) throw slam::InputError("the recording ends in the middle of scan 3");
+  });
+  EXPECT_THROW(map_source(source, mapper), slam::InputError);
+}
+
+TEST(MapPipeline, ProgressComesFromOneThreadInOrder) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_progress");
+  const slam::BoxRoomSettings room = small_room();
+  RunEvents events;
+  std::vector<size_t> mapped;
+  std::atomic<int> callers{0};
+  events.progress = [&](const RunProgress& at) {
+    EXPECT_EQ(callers.fetch_add(1), 0) << "two progress callbacks at once";
+    mapped.push_back(at.frames_mapped);
+    EXPECT_EQ(at.total_frames, std::optional<size_t>(12));
+    EXPECT_GE(at.frames_read, at.frames_mapped);
+    callers.fetch_sub(1);
+  };
+  Mapper mapper(room_mapper_settings(room, dir / "map.h5"), events);
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  map_source(*source, mapper);
+  ASSERT_EQ(mapped.size(), 12u);
+  for (size_t i = 0; i < mapped.size(); ++i) EXPECT_EQ(mapped[i], i + 1);
+}
+
+TEST(MapPipeline, AMapperFinishedTwiceOrFedAfterItsEndSaysSo) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_misuse");
+  const slam::BoxRoomSettings room = small_room(3);
+  Mapper mapper(room_mapper_settings(room, dir / "map.h5"));
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  while (std::optional<slam::Scan> scan = source->next()) mapper.add_scan(std::move(*scan));
+  mapper.finish();
+  EXPECT_THROW(mapper.finish(), std::logic_error);
+  EXPECT_THROW(mapper.add_scan(slam::Scan::allocate(2, 2)), std::logic_error);
+}
+
+}  // namespace
+}  // namespace featsense::mapping
