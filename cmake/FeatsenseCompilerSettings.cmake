@@ -28,9 +28,16 @@ function(featsense_warnings target)
   endif()
 endfunction()
 
-if(FEATSENSE_SANITIZE)
+string(TOLOWER "${FEATSENSE_SANITIZE}" featsense_sanitize)
+if(featsense_sanitize STREQUAL "thread")
+  # ThreadSanitizer: the pipeline's threads and queues (docs/LIBRARY.md says how to run it).
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+elseif(featsense_sanitize MATCHES "^(on|address|true|1)$")
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
   add_link_options(-fsanitize=address,undefined)
+elseif(NOT featsense_sanitize MATCHES "^(off|false|0|)$")
+  message(FATAL_ERROR "FEATSENSE_SANITIZE=${FEATSENSE_SANITIZE}: expected OFF, address or thread")
 endif()
 
 if(FEATSENSE_FUZZ)
