@@ -117,7 +117,8 @@ std::unique_ptr<storage::ChunkStore> open_map(const MeshOptions& options) {
   throw std::runtime_error(options.map + ": not a featsense map (expected .h5 or .vdb)");
 }
 
-void run_mesh(const MeshOptions& options) {
+/// Bad option values fail before the map is read.
+void check_options(const MeshOptions& options) {
   const std::string extension = viewer_export::mesh_extension(options.output);
   if (extension != ".ply" && extension != ".glb" && extension != ".gltf" && extension != ".obj") {
     throw config::ConfigError("-o: unknown mesh format '" + extension +
@@ -140,23 +141,102 @@ void run_mesh(const MeshOptions& options) {
     throw config::ConfigError("--min-component-area and --max-hole must be >= 0");
   }
   check_plan_options(options);
-  const std::vector<viewer_export::PlanPath> paths = plan_paths(options);
+}
+
+/// What a mesh run made, for the summary and --json.
+struct MeshRun {
   mesh::MeshingSettings settings;
-  settings.min_weight = options.min_weight;
-  settings.threads = options.threads;
-  if (!options.bbox.empty()) settings.bbox = parse_bbox(options.bbox);
+  mesh::MeshingStats stats;
+  mesh::TriangleMesh result;
+  std::optional<mesh::CleanupReport> cleanup;
+  std::optional<viewer_export::PlanView> plan;
+
+  double triangles_per_s() const {
+    return stats.seconds > 0.0 ? static_cast<double>(stats.triangles) / stats.seconds : 0.0;
+  }
+};
+
+void print_summary(const MeshOptions& options, const MeshRun& run) {
+  std::printf(
+      "%s: %zu vertices, %zu triangles (meshed: %zu) from %zu chunks in %.2f s (%.2f M "
+      "triangles/s)\n",
+      options.output.c_str(), run.result.vertices.size(), run.result.triangles.size(),
+      run.stats.triangles, run.stats.chunks, run.stats.seconds, run.triangles_per_s() * 1e-6);
+  if (run.cleanup) {
+    const mesh::CleanupReport& c = *run.cleanup;
+    std::printf(
+        "cleanup: %zu -> %zu triangles, %zu small components removed, %zu non-manifold vertices "
+        "split, %zu holes filled, simplification error max %.4f m mean %.4f m, %s, %s\n",
+        c.input_triangles, c.output_triangles, c.removed_components, c.non_manifold_vertices_fixed,
+        c.holes_filled, c.simplification_max_error_m, c.simplification_mean_error_m,
+        c.is_closed ? "closed" : "open", c.is_manifold ? "manifold" : "not manifold");
+  }
+  if (run.plan) {
+    std::printf("plan view: %s, %d x %d pixels of %.3f m, grid %g m; cut: %s\n",
+                options.plan_path->c_str(), run.plan->width_px, run.plan->height_px,
+                run.plan->pixel_size_m, run.plan->grid_spacing_m, run.plan->cut_rule.c_str());
+  }
+}
+
+nlohmann::json cleanup_json(const mesh::CleanupReport& c, const MeshOptions& options) {
+  nlohmann::json out = {{"input_triangles", c.input_triangles},
+                        {"output_triangles", c.output_triangles},
+                        {"output_vertices", c.output_vertices},
+                        {"degenerate_triangles_removed", c.degenerate_triangles_removed},
+                        {"removed_components", c.removed_components},
+                        {"removed_component_triangles", c.removed_component_triangles},
+                        {"non_manifold_vertices_fixed", c.non_manifold_vertices_fixed},
+                        {"holes_filled", c.holes_filled},
+                        {"holes_left", c.holes_left},
+                        {"simplify_ratio", options.simplify_ratio},
+                        {"simplification_max_error_m", c.simplification_max_error_m},
+                        {"simplification_mean_error_m", c.simplification_mean_error_m},
+                        {"border_edges", c.border_edges},
+                        {"is_closed", c.is_closed},
+                        {"is_manifold", c.is_manifold},
+                        {"is_valid", c.is_valid},
+                        {"seconds", c.seconds}};
+  if (options.check_self_intersections) out["self_intersections"] = c.self_intersections;
+  return out;
+}
+
+nlohmann::json mesh_run_json(const MeshOptions& options, const MeshRun& run) {
+  nlohmann::json report = {{"map", options.map},
+                           {"output", options.output},
+                           {"vertices", run.result.vertices.size()},
+                           {"triangles", run.result.triangles.size()},
+                           {"chunks", run.stats.chunks},
+                           {"voxels", run.stats.voxels},
+                           {"seconds", run.stats.seconds},
+                           {"triangles_per_s", run.triangles_per_s()},
+                           {"min_weight", options.min_weight}};
+  if (run.settings.bbox) {
+    const Eigen::AlignedBox3d& box = *run.settings.bbox;
+    report["bbox"] = {box.min().x(), box.min().y(), box.min().z(),
+                      box.max().x(), box.max().y(), box.max().z()};
+  }
+  if (run.cleanup) report["cleanup"] = cleanup_json(*run.cleanup, options);
+  if (run.plan) report["plan"] = plan_json(*run.plan, *options.plan_path);
+  return report;
+}
+
+void run_mesh(const MeshOptions& options) {
+  check_options(options);
+  const std::vector<viewer_export::PlanPath> paths = plan_paths(options);
+  MeshRun run;
+  run.settings.min_weight = options.min_weight;
+  run.settings.threads = options.threads;
+  if (!options.bbox.empty()) run.settings.bbox = parse_bbox(options.bbox);
 
   std::unique_ptr<storage::ChunkStore> store = open_map(options);
-  mesh::MeshingStats stats;
-  mesh::TriangleMesh result = mesh::extract_mesh(*store, settings, &stats);
+  run.result = mesh::extract_mesh(*store, run.settings, &run.stats);
   store.reset();
-  if (result.triangles.empty()) {
+  if (run.result.triangles.empty()) {
     throw std::runtime_error(options.map + ": no surface to mesh" +
-                             (settings.bbox ? " inside --bbox" : "") + " (" +
-                             std::to_string(stats.chunks) + " chunks, min weight " +
+                             (run.settings.bbox ? " inside --bbox" : "") + " (" +
+                             std::to_string(run.stats.chunks) + " chunks, min weight " +
                              std::to_string(options.min_weight) + ")");
   }
-  std::optional<mesh::CleanupReport> cleanup;
   if (options.clean || options.simplify_ratio < 1.0 || options.check_self_intersections) {
     mesh::CleanupSettings cleaning;
     if (options.clean) {
@@ -165,83 +245,23 @@ void run_mesh(const MeshOptions& options) {
     }
     cleaning.simplify_ratio = options.simplify_ratio;
     cleaning.check_self_intersections = options.check_self_intersections;
-    cleanup = mesh::clean_mesh(result, cleaning);
-    if (result.triangles.empty()) {
+    run.cleanup = mesh::clean_mesh(run.result, cleaning);
+    if (run.result.triangles.empty()) {
       throw std::runtime_error(options.map + ": nothing left after cleaning (" +
-                               std::to_string(cleanup->removed_components) +
+                               std::to_string(run.cleanup->removed_components) +
                                " small components removed)");
     }
   }
-  viewer_export::write_mesh(options.output, result);
-  std::optional<viewer_export::PlanView> plan;
+  viewer_export::write_mesh(options.output, run.result);
   if (options.plan_path) {
     // The path, where given, sets the cut; --plan-height overrides it.
     viewer_export::PlanViewSettings plan_settings;
     plan_settings.cut_height_m = options.plan_height;
-    plan = viewer_export::write_plan_view_png(result, paths, *options.plan_path, plan_settings);
+    run.plan =
+        viewer_export::write_plan_view_png(run.result, paths, *options.plan_path, plan_settings);
   }
-
-  const double triangles_per_s =
-      stats.seconds > 0.0 ? static_cast<double>(stats.triangles) / stats.seconds : 0.0;
-  std::printf(
-      "%s: %zu vertices, %zu triangles (meshed: %zu) from %zu chunks in %.2f s (%.2f M "
-      "triangles/s)\n",
-      options.output.c_str(), result.vertices.size(), result.triangles.size(), stats.triangles,
-      stats.chunks, stats.seconds, triangles_per_s * 1e-6);
-  if (cleanup) {
-    std::printf(
-        "cleanup: %zu -> %zu triangles, %zu small components removed, %zu non-manifold vertices "
-        "split, %zu holes filled, simplification error max %.4f m mean %.4f m, %s, %s\n",
-        cleanup->input_triangles, cleanup->output_triangles, cleanup->removed_components,
-        cleanup->non_manifold_vertices_fixed, cleanup->holes_filled,
-        cleanup->simplification_max_error_m, cleanup->simplification_mean_error_m,
-        cleanup->is_closed ? "closed" : "open", cleanup->is_manifold ? "manifold" : "not manifold");
-  }
-  if (plan) {
-    std::printf("plan view: %s, %d x %d pixels of %.3f m, grid %g m; cut: %s\n",
-                options.plan_path->c_str(), plan->width_px, plan->height_px, plan->pixel_size_m,
-                plan->grid_spacing_m, plan->cut_rule.c_str());
-  }
-  if (options.json_path) {
-    nlohmann::json report = {{"map", options.map},
-                             {"output", options.output},
-                             {"vertices", result.vertices.size()},
-                             {"triangles", result.triangles.size()},
-                             {"chunks", stats.chunks},
-                             {"voxels", stats.voxels},
-                             {"seconds", stats.seconds},
-                             {"triangles_per_s", triangles_per_s},
-                             {"min_weight", options.min_weight}};
-    if (settings.bbox) {
-      report["bbox"] = {settings.bbox->min().x(), settings.bbox->min().y(),
-                        settings.bbox->min().z(), settings.bbox->max().x(),
-                        settings.bbox->max().y(), settings.bbox->max().z()};
-    }
-    if (cleanup) {
-      const mesh::CleanupReport& c = *cleanup;
-      report["cleanup"] = {{"input_triangles", c.input_triangles},
-                           {"output_triangles", c.output_triangles},
-                           {"output_vertices", c.output_vertices},
-                           {"degenerate_triangles_removed", c.degenerate_triangles_removed},
-                           {"removed_components", c.removed_components},
-                           {"removed_component_triangles", c.removed_component_triangles},
-                           {"non_manifold_vertices_fixed", c.non_manifold_vertices_fixed},
-                           {"holes_filled", c.holes_filled},
-                           {"holes_left", c.holes_left},
-                           {"simplify_ratio", options.simplify_ratio},
-                           {"simplification_max_error_m", c.simplification_max_error_m},
-                           {"simplification_mean_error_m", c.simplification_mean_error_m},
-                           {"border_edges", c.border_edges},
-                           {"is_closed", c.is_closed},
-                           {"is_manifold", c.is_manifold},
-                           {"is_valid", c.is_valid},
-                           {"seconds", c.seconds}};
-      if (options.check_self_intersections)
-        report["cleanup"]["self_intersections"] = c.self_intersections;
-    }
-    if (plan) report["plan"] = plan_json(*plan, *options.plan_path);
-    write_json(report, *options.json_path);
-  }
+  print_summary(options, run);
+  if (options.json_path) write_json(mesh_run_json(options, run), *options.json_path);
 }
 
 }  // namespace

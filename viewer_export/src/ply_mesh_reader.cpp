@@ -91,11 +91,13 @@ int find(const Element& element, const std::string& name) {
   return -1;
 }
 
-}  // namespace
+/// The header: its encoding and the elements with their properties, up to end_header.
+struct PlyHeader {
+  Encoding encoding = Encoding::kAscii;
+  std::vector<Element> elements;
+};
 
-mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attributes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw PlyError(path + ": cannot open");
+PlyHeader read_header(std::istream& in, const std::string& path) {
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
     throw PlyError(path + ": not a PLY file (no 'ply' magic)");
@@ -103,9 +105,10 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attrib
   auto header_error = [&](size_t number, const std::string& what) {
     return PlyError(path + ": header line " + std::to_string(number) + ": " + what);
   };
-  Encoding encoding = Encoding::kAscii;
+  PlyHeader header;
+  Encoding& encoding = header.encoding;
+  std::vector<Element>& elements = header.elements;
   bool has_format = false;
-  std::vector<Element> elements;
   for (size_t number = 2;; ++number) {
     if (!std::getline(in, line)) throw header_error(number, "no end_header");
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -157,9 +160,19 @@ mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attrib
     }
   }
   if (!has_format) throw PlyError(path + ": header has no format line");
+  return header;
+}
+
+}  // namespace
+
+mesh::TriangleMesh read_ply_mesh(const std::string& path, MeshAttributes* attributes) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw PlyError(path + ": cannot open");
+  const PlyHeader header = read_header(in, path);
+  const std::vector<Element>& elements = header.elements;
 
   mesh::TriangleMesh mesh;
-  Reader reader(in, path, encoding);
+  Reader reader(in, path, header.encoding);
   bool has_vertices = false;
   for (const Element& element : elements) {
     const bool is_vertex = element.name == "vertex";

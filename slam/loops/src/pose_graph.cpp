@@ -160,6 +160,43 @@ Matrix6d square_root(const Matrix6d& information) {
   return llt.matrixU();
 }
 
+/// The map frame tilted back by what the gravity observations of every node say, about the
+/// first node (`first_position` stays), shrunk by the tilt's significance; fills `gravity`
+/// (but its accel_bias_mps2) and leaves `map_tilt_rad` at zero: the poses are levelled, the
+/// next solve starts from level.
+Eigen::Isometry3d level_by_gravity(const std::vector<GravityObservation>& observations,
+                                   const BiasBasis& basis,
+                                   const std::vector<Eigen::Quaterniond>& rotations,
+                                   const Eigen::Vector3d& first_position,
+                                   const Eigen::Vector2d& bias_coordinates, double bias_prior_mps2,
+                                   Eigen::Vector2d& map_tilt_rad, GravityEstimate& gravity) {
+  const GravityFit fit =
+      fit_gravity(observations, basis, rotations, map_tilt_rad, bias_coordinates, bias_prior_mps2);
+  gravity.observations = observations.size();
+  gravity.map_tilt_deg = map_tilt_rad * kDegreesPerRadian;
+  gravity.rms_whitened =
+      std::sqrt(fit.squared_residuals / (2.0 * static_cast<double>(observations.size())));
+  gravity.tilt_sigma_deg =
+      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(fit.tilt_covariance)
+                                  .eigenvalues()
+                                  .maxCoeff())) *
+      kDegreesPerRadian;
+  // An accelerometer's bias is told from a tilt only once the path turns: until then the
+  // tilt found is as uncertain as the bias over g. Shrink it towards the first node's level
+  // by its significance (none at one sigma, 89 % at three).
+  const double significance2 = map_tilt_rad.dot(fit.tilt_covariance.inverse() * map_tilt_rad);
+  const double shrink = significance2 > 1.0 ? 1.0 - 1.0 / significance2 : 0.0;
+  gravity.levelled_deg = shrink * map_tilt_rad.norm() * kDegreesPerRadian;
+  const Eigen::Vector3d axis(shrink * map_tilt_rad.x(), shrink * map_tilt_rad.y(), 0.0);
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  if (axis.norm() > 0.0) {
+    level.linear() = Eigen::AngleAxisd(axis.norm(), axis.normalized()).toRotationMatrix();
+    level.translation() = first_position - level.linear() * first_position;
+  }
+  map_tilt_rad.setZero();
+  return level;
+}
+
 }  // namespace
 
 Eigen::Matrix<double, 6, 1> edge_error(const Eigen::Isometry3d& T_map_from,
@@ -295,32 +332,9 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
   Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
   if (!gravity_.empty()) {
     accel_bias_ = basis * bias_coordinates;
-    const GravityFit fit =
-        fit_gravity(gravity_, basis, rotations, map_tilt_rad_, bias_coordinates, bias_prior_mps2_);
-    GravityEstimate& gravity = summary.gravity;
-    gravity.observations = gravity_.size();
-    gravity.map_tilt_deg = map_tilt_rad_ * kDegreesPerRadian;
-    gravity.accel_bias_mps2 = accel_bias_;
-    gravity.rms_whitened =
-        std::sqrt(fit.squared_residuals / (2.0 * static_cast<double>(gravity_.size())));
-    gravity.tilt_sigma_deg =
-        std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(fit.tilt_covariance)
-                                    .eigenvalues()
-                                    .maxCoeff())) *
-        kDegreesPerRadian;
-    // An accelerometer's bias is told from a tilt only once the path turns: until then the
-    // tilt found is as uncertain as the bias over g. Shrink it towards the first node's level
-    // by its significance (none at one sigma, 89 % at three).
-    const double significance2 = map_tilt_rad_.dot(fit.tilt_covariance.inverse() * map_tilt_rad_);
-    const double shrink = significance2 > 1.0 ? 1.0 - 1.0 / significance2 : 0.0;
-    gravity.levelled_deg = shrink * map_tilt_rad_.norm() * kDegreesPerRadian;
-    const Eigen::Vector3d axis(shrink * map_tilt_rad_.x(), shrink * map_tilt_rad_.y(), 0.0);
-    if (axis.norm() > 0.0) {
-      // About the first node: it keeps its position.
-      level.linear() = Eigen::AngleAxisd(axis.norm(), axis.normalized()).toRotationMatrix();
-      level.translation() = translations[0] - level.linear() * translations[0];
-    }
-    map_tilt_rad_.setZero();  // the poses are levelled: the next solve starts from level
+    summary.gravity.accel_bias_mps2 = accel_bias_;
+    level = level_by_gravity(gravity_, basis, rotations, translations[0], bias_coordinates,
+                             bias_prior_mps2_, map_tilt_rad_, summary.gravity);
   }
   for (size_t i = 0; i < poses_.size(); ++i) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
