@@ -1,12 +1,12 @@
 // featsense bench features / bench odometry: the front end's speed per scan, as JSON. The
 // scans are a simulated OS1-128 sequence (noise and motion distortion on, made before the
 // clock starts) or the first frames of a recording (--input). `features` times the feature
-// extraction alone; `odometry` times extraction and registration of each scan in order, as
-// the mapping run does, and gives the trajectory's error where the truth is known.
+// extraction alone; `odometry` runs the mapping engine's own front end over each scan in order
+// (the odometry locator, with --refine and --loops the map pass's refinement and loop
+// stages), times it and gives the trajectory's error where the truth is known.
 
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,12 +14,11 @@
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/mapping/loop_stage.hpp"
+#include "featsense/mapping/map_pass.hpp"
 #include "featsense/slam/features/feature_extractor.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
-#include "featsense/slam/odometry/feature_odometry.hpp"
+#include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
-#include "featsense/slam/refine/refinement_cloud.hpp"
-#include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 #include "json_output.hpp"
@@ -160,240 +159,6 @@ nlohmann::json run_bench_features(const BenchFrontEndOptions& options, const Cli
   return result;
 }
 
-/// The map refinement behind the odometry, as the mapping run does it: each scan deskewed
-/// with the odometry's motion, the stretches registered as they complete.
-class BenchRefinement {
- public:
-  explicit BenchRefinement(const config::Config& config)
-      : settings_(slam::refine::from_config(config)),
-        refiner_(settings_),
-        deskew_(config.odometry.deskew) {}
-
-  /// The placements made final by this scan (with their scans' sequence numbers).
-  std::vector<slam::ScanPlacement> add(const slam::Scan& scan,
-                                       const slam::odometry::OdometryResult& odometry) {
-    if (odometry.sweep.moving()) sweep_ = odometry.sweep;
-    slam::ScanPlacement placed;
-    placed.sequence = scan.sequence;
-    placed.stamp_ns = scan.stamp_ns;
-    placed.T_map_sensor = odometry.T_map_sensor;
-    if (deskew_ && sweep_.moving()) {
-      placed.column_T_map_sensor = slam::column_poses(scan, placed.T_map_sensor, [&](double t) {
-        return std::optional<Eigen::Isometry3d>(placed.T_map_sensor * sweep_.at(t));
-      });
-    }
-    return take(refiner_.add(scan, std::move(placed)));
-  }
-
-  /// The scans still held, refined as a shorter stretch.
-  std::vector<slam::ScanPlacement> finish() { return take(refiner_.finish()); }
-  const slam::Trajectory& refined() const { return refined_; }
-
-  nlohmann::json json() const {
-    const slam::refine::RefineCounts& counts = refiner_.counts();
-    // The first scan is a stretch of its own, with nothing to register.
-    const double stretches = static_cast<double>(std::max<size_t>(
-        counts.refined + counts.not_converged + counts.too_far + counts.worse_fit, 1));
-    std::vector<double> stretch_ms, step_m, step_deg;
-    double cloud_total_ms = 0.0, stretch_total_ms = 0.0;
-    for (const double ms : refiner_.cloud_ms()) cloud_total_ms += ms;
-    for (const slam::refine::StretchRegistration& r : counts.stretches) {
-      stretch_ms.push_back(r.ms);
-      stretch_total_ms += r.ms;
-      if (r.outcome != slam::refine::RefineOutcome::refined) continue;
-      step_m.push_back(r.step_m);
-      step_deg.push_back(r.step_deg);
-    }
-    return {{"distance_m", settings_.distance_m},
-            {"voxel_m", settings_.voxel_m},
-            {"stretches", counts.stretches.size()},
-            {"scans", counts.scans},
-            {"refined", counts.refined},
-            {"kept_not_converged", counts.not_converged},
-            {"kept_too_far", counts.too_far},
-            {"kept_worse_fit", counts.worse_fit},
-            {"clouds", refiner_.cloud_ms().size()},
-            {"cloud", timing_json(refiner_.cloud_ms())},
-            {"registration", timing_json(stretch_ms)},
-            // What the refinement costs per scan: its clouds and registrations over the scans.
-            {"per_scan_ms", (cloud_total_ms + stretch_total_ms) /
-                                static_cast<double>(std::max<size_t>(counts.scans, 1))},
-            // A stretch's refinement against the time its scans took to record: above 1 it
-            // keeps up with the sensor.
-            {"per_stretch_ms", (cloud_total_ms + stretch_total_ms) / stretches},
-            {"recorded_per_stretch_ms", recorded_ms() / stretches},
-            {"real_time_factor", recorded_ms() / std::max(cloud_total_ms + stretch_total_ms, 1e-9)},
-            {"step_m", min_median_max(step_m)},
-            {"step_deg", min_median_max(step_deg)}};
-  }
-
- private:
-  double recorded_ms() const {
-    if (refined_.size() < 2) return 0.0;
-    return static_cast<double>(refined_.stamps_ns.back() - refined_.stamps_ns.front()) * 1e-6;
-  }
-
-  std::vector<slam::ScanPlacement> take(std::vector<slam::ScanPlacement> placements) {
-    for (const slam::ScanPlacement& placement : placements)
-      refined_.push_back(placement.stamp_ns, placement.T_map_sensor);
-    return placements;
-  }
-
-  slam::refine::RefineSettings settings_;
-  slam::refine::PlacementRefiner refiner_;
-  bool deskew_;
-  slam::SweepMotion sweep_;  ///< the last scan's whose stamp advanced
-  slam::Trajectory refined_;
-};
-
-/// Loop closure over the final poses, as the mapping run does it but in line and timed: the
-/// keyframes' clouds, the search, the verification and the solves, and what the loops did to
-/// the path.
-class BenchLoops {
- public:
-  explicit BenchLoops(const config::Config& config)
-      : settings_(slam::loops::from_config(config)),
-        selector_(settings_.keyframe_distance_m, settings_.keyframe_angle_deg),
-        closer_(settings_) {}
-
-  void add(const slam::Scan& scan, const slam::ScanPlacement& placement) {
-    const bool keyframe = selector_.next(placement.T_map_sensor);
-    path_.push_back(placement.stamp_ns, placement.T_map_sensor);
-    travelled_m_.push_back(selector_.travelled_m());
-    slam::loops::append_in_time_order(&imu_, scan.imu);
-    if (!keyframe) return;
-    const auto start = Clock::now();
-    const std::vector<Eigen::Vector3f> points =
-        slam::refine::voxel_centroids(scan, placement, settings_.cloud_voxel_m);
-    cloud_ms_.push_back(ms_since(start));
-    closer_.add_keyframe(placement.stamp_ns, selector_.travelled_m(), placement.T_map_sensor,
-                         points);
-    keyframe_stamps_ns_.push_back(placement.stamp_ns);
-  }
-
-  /// The corrected poses of every scan added.
-  slam::Trajectory finish() {
-    gravity_ = closer_.finish(path_.stamps_ns, path_.poses, imu_).gravity;
-    return corrected();
-  }
-
-  /// The corrected poses of every scan added, from the graph as it is.
-  slam::Trajectory corrected() const {
-    return mapping::corrected_path(closer_.correction(), path_, travelled_m_);
-  }
-
-  /// A deliberately wrong loop added to the graph (and optimised): the keyframe three
-  /// quarters along the path claimed to lie 4 m ahead of the one a quarter along and turned
-  /// 30 degrees, as confident as the first true loop. What the claim is off by against the
-  /// truth, and the weight the robust loss left it.
-  nlohmann::json inject_wrong_loop(const std::optional<slam::Trajectory>& truth) {
-    const size_t n = closer_.keyframes();
-    if (n < 8) return {{"skipped", "fewer than 8 keyframes"}};
-    const size_t from = n / 4, to = 3 * n / 4;
-    Eigen::Isometry3d claim = Eigen::Isometry3d::Identity();
-    claim.linear() =
-        Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    claim.translation() = Eigen::Vector3d(4.0, 0.0, 0.0);
-    slam::loops::Matrix6d information = slam::loops::Matrix6d::Identity();
-    information.diagonal() << 1e4, 1e4, 1e4, 400.0, 400.0, 400.0;  // 0.01 rad, 5 cm
-    for (const slam::loops::PoseGraphEdge& edge : closer_.graph().edges()) {
-      if (edge.loop) {
-        information = edge.information;
-        break;
-      }
-    }
-    closer_.add_loop_edge(from, to, claim, information);
-    nlohmann::json out = {{"from", from}, {"to", to}, {"weight", closer_.loops().back().weight}};
-    const std::optional<Eigen::Isometry3d> a =
-        truth ? truth_at(*truth, keyframe_stamps_ns_[from]) : std::nullopt;
-    const std::optional<Eigen::Isometry3d> b =
-        truth ? truth_at(*truth, keyframe_stamps_ns_[to]) : std::nullopt;
-    if (a && b) {
-      const Eigen::Isometry3d error = (a->inverse() * *b).inverse() * claim;
-      out["claim_error_m"] = error.translation().norm();
-      out["claim_error_deg"] = slam::rotation_angle_deg(error.rotation());
-    }
-    return out;
-  }
-
-  /// Counts and times; with the truth, each loop's measured pose against it: a loop more than
-  /// 0.3 m or 2 degrees off is false (it would bend the map).
-  nlohmann::json json(const std::optional<slam::Trajectory>& truth) const {
-    const slam::loops::LoopCounts& counts = closer_.counts();
-    nlohmann::json rejected = nlohmann::json::object();
-    for (const auto& [reason, count] : counts.rejected) rejected[reason] = count;
-    double total_ms = 0.0;
-    for (const double ms : counts.keyframe_ms) total_ms += ms;
-    for (const double ms : cloud_ms_) total_ms += ms;
-    const double recorded_ms =
-        path_.size() < 2
-            ? 0.0
-            : static_cast<double>(path_.stamps_ns.back() - path_.stamps_ns.front()) * 1e-6;
-    nlohmann::json out = {{"keyframes", counts.keyframes},
-                          {"candidates", counts.candidates},
-                          {"verified", counts.verified},
-                          {"accepted", closer_.loops().size()},
-                          {"rejected", rejected},
-                          {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
-                          {"cloud", timing_json(cloud_ms_)},
-                          {"keyframe", timing_json(counts.keyframe_ms)},
-                          {"optimise", timing_json(counts.optimise_ms)},
-                          // The loop closure's time against the recording's: above 1 it
-                          // keeps up with the sensor on one core.
-                          {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)},
-                          {"gravity_observations", gravity_.observations}};
-    if (gravity_.observations > 0) {
-      out["gravity_map_tilt_deg"] = {gravity_.map_tilt_deg.x(), gravity_.map_tilt_deg.y()};
-      out["gravity_accel_bias_mps2"] = {gravity_.accel_bias_mps2.x(), gravity_.accel_bias_mps2.y(),
-                                        gravity_.accel_bias_mps2.z()};
-      out["gravity_map_tilt_sigma_deg"] = gravity_.tilt_sigma_deg;
-      out["gravity_levelled_deg"] = gravity_.levelled_deg;
-      out["gravity_rms_whitened"] = gravity_.rms_whitened;
-    }
-    if (!truth) return out;
-    size_t false_loops = 0;
-    double worst_m = 0.0, worst_deg = 0.0;
-    size_t k = 0;
-    for (const slam::loops::PoseGraphEdge& edge : closer_.graph().edges()) {
-      if (!edge.loop) continue;
-      ++k;
-      const std::optional<Eigen::Isometry3d> from =
-          truth_at(*truth, keyframe_stamps_ns_[edge.from]);
-      const std::optional<Eigen::Isometry3d> to = truth_at(*truth, keyframe_stamps_ns_[edge.to]);
-      if (!from || !to) continue;
-      const Eigen::Isometry3d error = (from->inverse() * *to).inverse() * edge.T_from_to;
-      const double m = error.translation().norm();
-      const double deg = slam::rotation_angle_deg(error.rotation());
-      worst_m = std::max(worst_m, m);
-      worst_deg = std::max(worst_deg, deg);
-      if (m > 0.3 || deg > 2.0) ++false_loops;
-    }
-    out["false_loops"] = false_loops;
-    out["worst_loop_error_m"] = worst_m;
-    out["worst_loop_error_deg"] = worst_deg;
-    return out;
-  }
-
- private:
-  static std::optional<Eigen::Isometry3d> truth_at(const slam::Trajectory& truth,
-                                                   int64_t stamp_ns) {
-    for (size_t i = 0; i < truth.size(); ++i) {
-      if (truth.stamps_ns[i] == stamp_ns) return truth.poses[i];
-    }
-    return std::nullopt;
-  }
-
-  slam::loops::LoopSettings settings_;
-  slam::loops::KeyframeSelector selector_;
-  slam::loops::LoopCloser closer_;
-  slam::Trajectory path_;
-  std::vector<double> travelled_m_;
-  std::vector<double> cloud_ms_;
-  std::vector<int64_t> keyframe_stamps_ns_;
-  std::vector<slam::ImuSample> imu_;  ///< every scan's, in order
-  slam::loops::GravityEstimate gravity_;
-};
-
 /// The trajectory's error against the truth, as JSON (nothing where it is undetermined).
 void add_trajectory_error(const slam::Trajectory& estimate, const slam::Trajectory& truth,
                           nlohmann::json& out) {
@@ -410,114 +175,248 @@ void add_trajectory_error(const slam::Trajectory& estimate, const slam::Trajecto
   }
 }
 
-nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const CliContext& context) {
-  const config::Config config = context.load_config({});
-  BenchScans scans(options, config);
-  const slam::features::FeatureSettings settings = slam::features::from_config(config);
-  slam::odometry::FeatureOdometry odometry(slam::odometry::from_config(config));
-  std::optional<BenchRefinement> refinement;
-  if (options.refine) refinement.emplace(config);
-  std::optional<BenchLoops> loops;
-  if (options.loops) loops.emplace(config);
-  // With the refinement, the scans wait for their final poses before the loops see them.
-  std::deque<slam::Scan> held;
-  const auto to_loops = [&](const std::vector<slam::ScanPlacement>& final) {
-    for (const slam::ScanPlacement& placement : final) {
-      while (!held.empty() && held.front().sequence != placement.sequence) held.pop_front();
-      if (held.empty()) continue;
-      loops->add(held.front(), placement);
-      held.pop_front();
-    }
-  };
+/// The refinement's figures: stretches, what was kept and why, its cost per scan and per
+/// stretch against the time the stretch took to record, the corrections.
+nlohmann::json bench_refine_json(const mapping::PassResult& run,
+                                 const slam::refine::RefineSettings& settings) {
+  const slam::refine::RefineCounts& counts = run.refine;
+  // The first scan is a stretch of its own, with nothing to register.
+  const double stretches = static_cast<double>(std::max<size_t>(
+      counts.refined + counts.not_converged + counts.too_far + counts.worse_fit, 1));
+  std::vector<double> stretch_ms, step_m, step_deg;
+  double cloud_total_ms = 0.0, stretch_total_ms = 0.0;
+  for (const double ms : run.refine_cloud_ms) cloud_total_ms += ms;
+  for (const slam::refine::StretchRegistration& r : counts.stretches) {
+    stretch_ms.push_back(r.ms);
+    stretch_total_ms += r.ms;
+    if (r.outcome != slam::refine::RefineOutcome::refined) continue;
+    step_m.push_back(r.step_m);
+    step_deg.push_back(r.step_deg);
+  }
+  const slam::Trajectory& refined = run.poses;
+  const double recorded_ms =
+      refined.size() < 2
+          ? 0.0
+          : static_cast<double>(refined.stamps_ns.back() - refined.stamps_ns.front()) * 1e-6;
+  const double total_ms = cloud_total_ms + stretch_total_ms;
+  return {{"distance_m", settings.distance_m},
+          {"voxel_m", settings.voxel_m},
+          {"stretches", counts.stretches.size()},
+          {"scans", counts.scans},
+          {"refined", counts.refined},
+          {"kept_not_converged", counts.not_converged},
+          {"kept_too_far", counts.too_far},
+          {"kept_worse_fit", counts.worse_fit},
+          {"clouds", run.refine_cloud_ms.size()},
+          {"cloud", timing_json(run.refine_cloud_ms)},
+          {"registration", timing_json(stretch_ms)},
+          // What the refinement costs per scan: its clouds and registrations over the scans.
+          {"per_scan_ms", total_ms / static_cast<double>(std::max<size_t>(counts.scans, 1))},
+          // A stretch's refinement against the time its scans took to record: above 1 it keeps
+          // up with the sensor.
+          {"per_stretch_ms", total_ms / stretches},
+          {"recorded_per_stretch_ms", recorded_ms / stretches},
+          {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)},
+          {"step_m", min_median_max(step_m)},
+          {"step_deg", min_median_max(step_deg)}};
+}
 
-  std::vector<double> features_ms, registration_ms, total_ms, feature_counts;
-  std::vector<double> association_ms, solve_ms, map_update_ms;
-  double startup_ms = 0.0;
-  size_t degenerate = 0, failed = 0;
-  slam::Trajectory estimate;
-  slam::odometry::OdometryResult last;
-  for (size_t i = 0;; ++i) {
-    const std::optional<slam::Scan> scan = scans.next();
-    if (!scan) break;
-    const auto start = Clock::now();
-    const slam::FeatureSet found = slam::features::extract_features(*scan, settings);
-    const auto extracted = Clock::now();
-    const slam::odometry::OdometryResult result = odometry.register_scan(found, scan->imu);
-    const double registration = ms_since(extracted);
-    const double features = std::chrono::duration<double, std::milli>(extracted - start).count();
-    estimate.stamps_ns.push_back(scan->stamp_ns);
-    estimate.poses.push_back(result.T_map_sensor);
-    if (loops && refinement) held.push_back(*scan);
-    if (refinement) {
-      const std::vector<slam::ScanPlacement> final = refinement->add(*scan, result);
-      if (loops) to_loops(final);
-    } else if (loops) {
-      slam::ScanPlacement placement;
-      placement.sequence = scan->sequence;
-      placement.stamp_ns = scan->stamp_ns;
-      placement.T_map_sensor = result.T_map_sensor;
-      loops->add(*scan, placement);
+std::optional<Eigen::Isometry3d> truth_at(const slam::Trajectory& truth, int64_t stamp_ns) {
+  for (size_t i = 0; i < truth.size(); ++i) {
+    if (truth.stamps_ns[i] == stamp_ns) return truth.poses[i];
+  }
+  return std::nullopt;
+}
+
+/// The loop closure's figures: counts and times; with the truth, each loop's measured pose
+/// against it: a loop more than 0.3 m or 2 degrees off is false (it would bend the map).
+nlohmann::json bench_loops_json(const mapping::LoopOutcome& outcome,
+                                const slam::loops::LoopCloser& closer,
+                                const std::optional<slam::Trajectory>& truth) {
+  const slam::loops::LoopCounts& counts = outcome.counts;
+  nlohmann::json rejected = nlohmann::json::object();
+  for (const auto& [reason, count] : counts.rejected) rejected[reason] = count;
+  double total_ms = 0.0;
+  for (const double ms : counts.keyframe_ms) total_ms += ms;
+  for (const double ms : outcome.keyframe_cloud_ms) total_ms += ms;
+  const slam::Trajectory& path = outcome.before;
+  const double recorded_ms =
+      path.size() < 2 ? 0.0
+                      : static_cast<double>(path.stamps_ns.back() - path.stamps_ns.front()) * 1e-6;
+  const slam::loops::GravityEstimate& gravity = outcome.gravity;
+  nlohmann::json out = {{"keyframes", counts.keyframes},
+                        {"candidates", counts.candidates},
+                        {"verified", counts.verified},
+                        {"accepted", outcome.loops.size()},
+                        {"rejected", rejected},
+                        {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
+                        {"cloud", timing_json(outcome.keyframe_cloud_ms)},
+                        {"keyframe", timing_json(counts.keyframe_ms)},
+                        {"optimise", timing_json(counts.optimise_ms)},
+                        // The loop closure's time against the recording's: above 1 it keeps up
+                        // with the sensor on one core.
+                        {"real_time_factor", recorded_ms / std::max(total_ms, 1e-9)},
+                        {"gravity_observations", gravity.observations}};
+  if (gravity.observations > 0) {
+    out["gravity_map_tilt_deg"] = {gravity.map_tilt_deg.x(), gravity.map_tilt_deg.y()};
+    out["gravity_accel_bias_mps2"] = {gravity.accel_bias_mps2.x(), gravity.accel_bias_mps2.y(),
+                                      gravity.accel_bias_mps2.z()};
+    out["gravity_map_tilt_sigma_deg"] = gravity.tilt_sigma_deg;
+    out["gravity_levelled_deg"] = gravity.levelled_deg;
+    out["gravity_rms_whitened"] = gravity.rms_whitened;
+  }
+  if (!truth) return out;
+  const std::vector<slam::loops::KeyframeRecord> keyframes = closer.keyframe_records();
+  size_t false_loops = 0;
+  double worst_m = 0.0, worst_deg = 0.0;
+  for (const slam::loops::PoseGraphEdge& edge : closer.graph().edges()) {
+    if (!edge.loop) continue;
+    const std::optional<Eigen::Isometry3d> from = truth_at(*truth, keyframes[edge.from].stamp_ns);
+    const std::optional<Eigen::Isometry3d> to = truth_at(*truth, keyframes[edge.to].stamp_ns);
+    if (!from || !to) continue;
+    const Eigen::Isometry3d error = (from->inverse() * *to).inverse() * edge.T_from_to;
+    const double m = error.translation().norm();
+    const double deg = slam::rotation_angle_deg(error.rotation());
+    worst_m = std::max(worst_m, m);
+    worst_deg = std::max(worst_deg, deg);
+    if (m > 0.3 || deg > 2.0) ++false_loops;
+  }
+  out["false_loops"] = false_loops;
+  out["worst_loop_error_m"] = worst_m;
+  out["worst_loop_error_deg"] = worst_deg;
+  return out;
+}
+
+/// A deliberately wrong loop added to the finished graph (and optimised): the keyframe three
+/// quarters along the path claimed to lie 4 m ahead of the one a quarter along and turned 30
+/// degrees, as confident as the first true loop. What the claim is off by against the truth,
+/// and the weight the robust loss left it.
+nlohmann::json inject_wrong_loop(slam::loops::LoopCloser& closer,
+                                 const std::optional<slam::Trajectory>& truth) {
+  const size_t n = closer.keyframes();
+  if (n < 8) return {{"skipped", "fewer than 8 keyframes"}};
+  const size_t from = n / 4, to = 3 * n / 4;
+  Eigen::Isometry3d claim = Eigen::Isometry3d::Identity();
+  claim.linear() =
+      Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  claim.translation() = Eigen::Vector3d(4.0, 0.0, 0.0);
+  slam::loops::Matrix6d information = slam::loops::Matrix6d::Identity();
+  information.diagonal() << 1e4, 1e4, 1e4, 400.0, 400.0, 400.0;  // 0.01 rad, 5 cm
+  for (const slam::loops::PoseGraphEdge& edge : closer.graph().edges()) {
+    if (edge.loop) {
+      information = edge.information;
+      break;
     }
-    last = result;
-    if (result.diagnostics.degenerate) ++degenerate;
-    if (i > 0 && !result.diagnostics.converged) ++failed;
+  }
+  const std::vector<slam::loops::KeyframeRecord> keyframes = closer.keyframe_records();
+  closer.add_loop_edge(from, to, claim, information);
+  nlohmann::json out = {{"from", from}, {"to", to}, {"weight", closer.loops().back().weight}};
+  const std::optional<Eigen::Isometry3d> a =
+      truth ? truth_at(*truth, keyframes[from].stamp_ns) : std::nullopt;
+  const std::optional<Eigen::Isometry3d> b =
+      truth ? truth_at(*truth, keyframes[to].stamp_ns) : std::nullopt;
+  if (a && b) {
+    const Eigen::Isometry3d error = (a->inverse() * *b).inverse() * claim;
+    out["claim_error_m"] = error.translation().norm();
+    out["claim_error_deg"] = slam::rotation_angle_deg(error.rotation());
+  }
+  return out;
+}
+
+/// The odometry's own figures, from the product's locator: per-stage times of every scan
+/// after the first two (which start the map), features per scan, degenerate and failed scans.
+void add_odometry_figures(const slam::odometry::OdometryCounts& counts, nlohmann::json& result) {
+  std::vector<double> features, registration, total, association, solve, map_update, found;
+  double startup_ms = 0.0;
+  for (size_t i = 0; i < counts.features_ms.size(); ++i) {
     // The first scan only starts the map, the second restarts it with the first deskewed once
     // the motion is known (FeatureOdometry): start-up, reported apart.
     if (i < 2) {
-      startup_ms += features + registration;
+      startup_ms += counts.features_ms[i] + counts.registration_ms[i];
       continue;
     }
-    features_ms.push_back(features);
-    association_ms.push_back(result.timing.association_ms);
-    solve_ms.push_back(result.timing.solve_ms);
-    map_update_ms.push_back(result.timing.map_update_ms);
-    registration_ms.push_back(registration);
-    total_ms.push_back(features + registration);
-    feature_counts.push_back(static_cast<double>(found.size()));
+    features.push_back(counts.features_ms[i]);
+    registration.push_back(counts.registration_ms[i]);
+    total.push_back(counts.features_ms[i] + counts.registration_ms[i]);
+    association.push_back(counts.association_ms[i]);
+    solve.push_back(counts.solve_ms[i]);
+    map_update.push_back(counts.map_update_ms[i]);
+    found.push_back(counts.features_per_scan[i]);
   }
-  scans.check_read(options.input.input);
-  nlohmann::json result = scans.json("odometry");
-  result["intensity_fusion"] = settings.intensity_fusion;
-  result["timed_scans"] = total_ms.size();
+  result["timed_scans"] = total.size();
   result["startup_ms"] = startup_ms;
-  result["optimization_steps"] = config.odometry.optimization_steps;
-  result["deskew"] = config.odometry.deskew;
-  result["features"] = timing_json(features_ms);
-  result["registration"] = timing_json(registration_ms);
-  result["total"] = timing_json(total_ms);
-  result["registration_stages_median_ms"] = {
-      {"association", summarize_ms(association_ms).median_ms},
-      {"solve", summarize_ms(solve_ms).median_ms},
-      {"map_update", summarize_ms(map_update_ms).median_ms}};
-  result["features_per_scan"] = min_median_max(feature_counts);
-  result["degenerate_scans"] = degenerate;
-  result["failed_scans"] = failed;
+  result["features"] = timing_json(features);
+  result["registration"] = timing_json(registration);
+  result["total"] = timing_json(total);
+  result["registration_stages_median_ms"] = {{"association", summarize_ms(association).median_ms},
+                                             {"solve", summarize_ms(solve).median_ms},
+                                             {"map_update", summarize_ms(map_update).median_ms}};
+  result["features_per_scan"] = min_median_max(found);
+  result["degenerate_scans"] = counts.degenerate_scans;
+  result["failed_scans"] = counts.failed_scans;
   // The local feature map is bounded (odometry.map_radius): memory stays flat however long
   // the run.
-  result["map_points"] = {{"edges", last.map_edges}, {"surfaces", last.map_surfaces}};
+  result["map_points"] = {{"edges", counts.map_edges}, {"surfaces", counts.map_surfaces}};
+}
+
+/// The front end as `featsense map` runs it, poses only, one scan at a time: the product's
+/// odometry locator, and with --refine / --loops the map pass's own refinement and loop
+/// stages (slam/mapping). The scans are simulated outside the clock.
+nlohmann::json run_bench_odometry(const BenchFrontEndOptions& options, const CliContext& context) {
+  config::Config config = context.load_config({});
+  BenchScans scans(options, config);
+  const std::unique_ptr<slam::odometry::OdometryLocator> odometry =
+      slam::odometry::make_odometry_locator(config);
+  mapping::PassSettings stages;
+  stages.integrate = false;
+  stages.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
+  if (options.refine) stages.refine = slam::refine::from_config(config);
+  if (options.loops) stages.loops = slam::loops::from_config(config);
+  mapping::MapPass pass(*odometry, stages, config, config::SensorModel{}, {}, {});
+  slam::Trajectory estimate;  // the odometry's poses, before the refinement
+  const auto map_final = [&pass](std::vector<mapping::PlacedScan> final) {
+    for (mapping::PlacedScan& scan : final) {
+      if (std::optional<mapping::LocatedScan> located = pass.make_rays(std::move(scan)))
+        pass.integrate(std::move(*located));
+    }
+  };
+  while (std::optional<slam::Scan> scan = scans.next()) {
+    pass.count_read();
+    std::optional<mapping::PlacedScan> placed = pass.locate(std::move(*scan));
+    if (!placed) continue;
+    estimate.push_back(placed->placement.stamp_ns, placed->placement.T_map_sensor);
+    map_final(pass.refine(std::move(*placed)));
+  }
+  map_final(pass.finish_refinement());
+  scans.check_read(options.input.input);
+  const mapping::PassResult run = pass.close();
+
+  nlohmann::json result = scans.json("odometry");
+  result["intensity_fusion"] = config.odometry.intensity_fusion;
+  result["optimization_steps"] = config.odometry.optimization_steps;
+  result["deskew"] = config.odometry.deskew;
+  add_odometry_figures(odometry->counts(), result);
   result["peak_rss_mb"] = peak_rss_mb();
+  const std::optional<slam::Trajectory>& truth = scans.truth();
   if (!options.estimate_out.empty()) slam::write_tum(estimate, options.estimate_out);
-  if (scans.truth()) add_trajectory_error(estimate, *scans.truth(), result);
-  if (scans.truth() && !options.truth_out.empty())
-    slam::write_tum(*scans.truth(), options.truth_out);
-  if (refinement) {
-    const std::vector<slam::ScanPlacement> final = refinement->finish();
-    if (loops) to_loops(final);
-    const slam::Trajectory& refined = refinement->refined();
-    if (!options.refined_out.empty()) slam::write_tum(refined, options.refined_out);
-    nlohmann::json refine = refinement->json();
-    if (scans.truth()) add_trajectory_error(refined, *scans.truth(), refine);
+  if (truth) add_trajectory_error(estimate, *truth, result);
+  if (truth && !options.truth_out.empty()) slam::write_tum(*truth, options.truth_out);
+  if (stages.refine) {
+    if (!options.refined_out.empty()) slam::write_tum(run.poses, options.refined_out);
+    nlohmann::json refine = bench_refine_json(run, *stages.refine);
+    if (truth) add_trajectory_error(run.poses, *truth, refine);
     result["refine"] = refine;
   }
-  if (loops) {
-    const slam::Trajectory corrected = loops->finish();
-    if (!options.corrected_out.empty()) slam::write_tum(corrected, options.corrected_out);
-    nlohmann::json closed = loops->json(scans.truth());
-    if (scans.truth()) add_trajectory_error(corrected, *scans.truth(), closed);
+  if (run.loops) {
+    mapping::LoopStage& stage = *pass.loop_stage();
+    if (!options.corrected_out.empty())
+      slam::write_tum(run.loops->corrected, options.corrected_out);
+    nlohmann::json closed = bench_loops_json(*run.loops, stage.closer_after_finish(), truth);
+    if (truth) add_trajectory_error(run.loops->corrected, *truth, closed);
     if (options.wrong_loop) {
-      nlohmann::json wrong = loops->inject_wrong_loop(scans.truth());
-      if (scans.truth() && !wrong.contains("skipped")) {
-        add_trajectory_error(loops->corrected(), *scans.truth(), wrong);
+      nlohmann::json wrong = inject_wrong_loop(stage.closer_after_finish(), truth);
+      if (truth && !wrong.contains("skipped")) {
+        add_trajectory_error(stage.corrected(), *truth, wrong);
         if (closed.contains("ape_rmse_m") && wrong.contains("ape_rmse_m"))
           wrong["ape_ratio"] = wrong["ape_rmse_m"].get<double>() /
                                std::max(closed["ape_rmse_m"].get<double>(), 1e-12);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include "featsense/slam/refine/refinement_cloud.hpp"
 
@@ -68,8 +69,10 @@ bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placeme
   job.travelled_m = selector_.travelled_m();
   job.T_map_sensor = placement.T_map_sensor;
   job.scan = scan_index;
+  const auto cloud_start = std::chrono::steady_clock::now();
   job.points = slam::refine::voxel_centroids(scan, placement, settings_.cloud_voxel_m);
   const auto start = std::chrono::steady_clock::now();
+  cloud_ms_.push_back(std::chrono::duration<double, std::milli>(start - cloud_start).count());
   const bool queued = queue_.push(std::move(job));
   wait_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -82,7 +85,9 @@ LoopOutcome LoopStage::finish() {
   queue_.close();
   if (worker_.joinable()) worker_.join();
   if (failure_) std::rethrow_exception(failure_);
+  finished_ = true;
   LoopOutcome out;
+  out.keyframe_cloud_ms = cloud_ms_;
   // The loop thread is done with the closer: the gravity goes in from here.
   out.final_optimisation = closer_.finish(path_.stamps_ns, path_.poses, imu_);
   out.gravity = out.final_optimisation.gravity;
@@ -96,13 +101,22 @@ LoopOutcome LoopStage::finish() {
     out.relocalize_gave_up = relocalize_gave_up_.load();
   }
   out.before = path_;
-  out.corrected = corrected_path(closer_.correction(), path_, travelled_m_);
+  out.corrected = corrected();
   for (size_t i = 0; i < path_.size(); ++i) {
     out.corrections_max_m =
         std::max(out.corrections_max_m,
                  (out.corrected.poses[i].translation() - path_.poses[i].translation()).norm());
   }
   return out;
+}
+
+slam::loops::LoopCloser& LoopStage::closer_after_finish() {
+  if (!finished_) throw std::logic_error("the loop closer belongs to its thread until finish()");
+  return closer_;
+}
+
+slam::Trajectory LoopStage::corrected() const {
+  return corrected_path(closer_.correction(), path_, travelled_m_);
 }
 
 }  // namespace featsense::mapping

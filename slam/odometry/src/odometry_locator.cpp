@@ -46,6 +46,12 @@ class FeatureOdometryLocator final : public OdometryLocator {
     const OdometryResult result = odometry_.register_scan(found, scan.imu);
     counts_.features_ms.push_back(milliseconds(extracted - start));
     counts_.registration_ms.push_back(milliseconds(std::chrono::steady_clock::now() - extracted));
+    counts_.association_ms.push_back(result.timing.association_ms);
+    counts_.solve_ms.push_back(result.timing.solve_ms);
+    counts_.map_update_ms.push_back(result.timing.map_update_ms);
+    counts_.features_per_scan.push_back(static_cast<double>(found.size()));
+    counts_.map_edges = result.map_edges;
+    counts_.map_surfaces = result.map_surfaces;
     ++counts_.scans;
     counts_.features_sum += static_cast<double>(found.size());
     if (found.intensity_confirmed) ++counts_.intensity_confirmed_scans;

@@ -28,8 +28,9 @@ struct LoopOutcome {
   /// Every scan offered: the pose it came with, and corrected by the keyframes around it.
   slam::Trajectory before;
   slam::Trajectory corrected;
-  double corrections_max_m = 0.0;       ///< the largest move of a scan's position
-  double keyframe_queue_wait_ms = 0.0;  ///< the pipeline's wait for the loop thread, in all
+  double corrections_max_m = 0.0;         ///< the largest move of a scan's position
+  double keyframe_queue_wait_ms = 0.0;    ///< the pipeline's wait for the loop thread, in all
+  std::vector<double> keyframe_cloud_ms;  ///< per keyframe: its points thinned for the closer
   /// Where the input had an IMU: gravity levelled the graph (observations > 0).
   slam::loops::GravityEstimate gravity;
   /// The keyframes at their final poses, for the map file (later sessions relocalize in them).
@@ -74,6 +75,11 @@ class LoopStage {
   /// Stops the loop thread without waiting for what is queued (a failing pipeline).
   void abandon();
 
+  /// After finish(): the loop closer, for a bench that adds a loop of its own, and every
+  /// scan's pose corrected by the graph as it is then.
+  slam::loops::LoopCloser& closer_after_finish();
+  slam::Trajectory corrected() const;
+
  private:
   struct KeyframeJob {
     int64_t stamp_ns = 0;
@@ -93,6 +99,8 @@ class LoopStage {
   std::vector<double> travelled_m_;
   std::vector<slam::ImuSample> imu_;  ///< every scan's, in order
   double wait_ms_ = 0.0;
+  std::vector<double> cloud_ms_;
+  bool finished_ = false;
   std::optional<RelocalizeStage> relocalize_;
   std::atomic<bool> relocalize_gave_up_{false};
   std::thread worker_;  ///< last: it starts once everything it uses is there

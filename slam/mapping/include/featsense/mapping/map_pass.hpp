@@ -115,6 +115,9 @@ class MapPass {
   /// into the store. Call once, after every stage is done.
   PassResult close();
 
+  /// The loop closure's stage (null without one), for a bench after close().
+  LoopStage* loop_stage() { return loops_.get(); }
+
   /// Results of the stages so far; read only from the thread that calls integrate().
   const PassResult& result() const { return result_; }
 

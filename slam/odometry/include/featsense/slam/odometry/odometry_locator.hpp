@@ -24,6 +24,14 @@ struct OdometryCounts {
   double features_sum = 0.0;            ///< edge + surface points, summed over scans
   std::vector<double> features_ms;      ///< per scan: the feature extraction
   std::vector<double> registration_ms;  ///< per scan: the registration and the map update
+  /// Per scan, the registration's parts: associations, solves, the local map's update.
+  std::vector<double> association_ms;
+  std::vector<double> solve_ms;
+  std::vector<double> map_update_ms;
+  std::vector<double> features_per_scan;  ///< edge + surface points of each scan
+  /// The local feature map after the last scan (bounded by odometry.map_radius).
+  size_t map_edges = 0;
+  size_t map_surfaces = 0;
 };
 
 class OdometryLocator : public ScanLocator {
