@@ -8,9 +8,9 @@
 
 #include "commands.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
+#include "featsense/slam/sim/simulated_scan_source.hpp"
 #include "map_job.hpp"
 #include "simulate_job.hpp"
-#include "simulated_scan_source.hpp"
 
 namespace featsense::app {
 namespace {
@@ -108,9 +108,9 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
 
   const fs::path out(options.output);
   const fs::path truth = out / "ground_truth";
-  SimulatedScanSource source(simulation,
-                             "built-in scene " + options.scene + ", " + options.path + " path",
-                             truth.string());
+  const std::string description = "built-in scene " + options.scene + ", " + options.path + " path";
+  slam::SimulatedScanSource source(*simulation.simulator, simulation.mesh, *simulation.trajectory,
+                                   simulation.frames, description, truth.string());
 
   MeshReferences references;
   references.surface = truth / "gt_mesh.ply";
@@ -123,9 +123,9 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   // The simulation runs again for the loop closure's second pass (the same scans: it is
   // deterministic).
   const SourceReopener reopen = [&]() -> std::unique_ptr<slam::ScanSource> {
-    return std::make_unique<SimulatedScanSource>(
-        simulation, "built-in scene " + options.scene + ", " + options.path + " path",
-        truth.string());
+    return std::make_unique<slam::SimulatedScanSource>(*simulation.simulator, simulation.mesh,
+                                                       *simulation.trajectory, simulation.frames,
+                                                       description, truth.string());
   };
   const MapOutcome outcome = map_recording(
       source, given, options.gt_poses ? std::nullopt : std::optional<KnownTrajectory>(truth_path),
