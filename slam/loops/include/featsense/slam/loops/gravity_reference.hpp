@@ -17,14 +17,15 @@
 #include <cstdint>
 #include <vector>
 
+#include "featsense/config/config.hpp"
 #include "featsense/slam/imu_sample.hpp"
 
 namespace featsense::slam::loops {
 
 struct GravitySettings {
-  bool enabled = true;
-  /// The IMU samples averaged around each keyframe, seconds.
-  double window_s = 4.0;
+  bool enabled = config::LoopConfig{}.gravity;  ///< loop.gravity
+  /// The IMU samples averaged around each keyframe, seconds (loop.gravity_window).
+  double window_s = config::LoopConfig{}.gravity_window_s;
   /// Velocities from the positions this far apart, seconds. A mean velocity stands for the
   /// instant velocity at its middle up to jerk x baseline^2 / 24: at 0.4 s a bend's jerk of
   /// 1 m/s^3 reads as a tilt of 0.02 deg, at 0.2 s a quarter of it; shorter lets the odometry's

@@ -36,24 +36,38 @@
 
 namespace featsense::slam::loops {
 
+/// The registration that verifies a loop candidate: coarse voxels first (a descriptor's guess
+/// is metres off), a good fit at the end.
+inline refine::VgicpSettings verification_vgicp() {
+  refine::VgicpSettings settings;
+  settings.voxel_sizes_m = {4.0, 2.0, 1.0, 0.5};
+  settings.max_iterations = 20;
+  settings.step_tolerance_m = 5e-4;
+  settings.inlier_distance_m = 0.2;
+  settings.fitness_voxel_m = 0.5;
+  return settings;
+}
+
+/// Where a setting has a config key (loop.*), its default is the configuration's
+/// (config/include/featsense/config/config.hpp): one home per default.
 struct LoopSettings {
   /// KeyframeSelector's spacing: metres travelled or degrees turned.
-  double keyframe_distance_m = 1.0;
-  double keyframe_angle_deg = 15.0;
+  double keyframe_distance_m = config::LoopConfig{}.keyframe_distance_m;
+  double keyframe_angle_deg = config::LoopConfig{}.keyframe_angle_deg;
   /// Candidates are at least this old and this far back along the path.
-  double min_separation_s = 10.0;
-  double min_separation_m = 20.0;
+  double min_separation_s = config::LoopConfig{}.min_separation_s;
+  double min_separation_m = config::LoopConfig{}.min_separation_m;
   ScanContextSettings scan_context;
   /// Keyframes compared in full after the ring keys, and the largest descriptor distance that
   /// makes a candidate.
   size_t descriptor_candidates = 6;
   /// Of those within max_descriptor_distance, the best this many are verified.
   size_t descriptor_verifications = 1;
-  double max_descriptor_distance = 0.35;
+  double max_descriptor_distance = config::LoopConfig{}.max_descriptor_distance;
   /// The odometry's drift: the position search radius and the consistency check's tolerance
   /// are base + per_m x the distance travelled since the last closure.
   double drift_base_m = 2.0;
-  double drift_per_m = 0.02;
+  double drift_per_m = config::LoopConfig{}.drift;
   double drift_base_deg = 5.0;
   double drift_deg_per_m = 0.02;
   size_t position_candidates = 1;
@@ -65,9 +79,9 @@ struct LoopSettings {
   int neighbours = 10;
   /// The verification: coarse voxels first (a descriptor's guess is metres off), a good fit
   /// at the end.
-  refine::VgicpSettings vgicp = {{4.0, 2.0, 1.0, 0.5}, 20, 5e-4, 0.2, 0.5};
-  double max_fitness_m = 0.12;
-  double min_inlier_fraction = 0.55;
+  refine::VgicpSettings vgicp = verification_vgicp();
+  double max_fitness_m = config::LoopConfig{}.max_fitness_m;
+  double min_inlier_fraction = config::LoopConfig{}.min_inlier_fraction;
   /// A keyframe is registered against the candidate and this many keyframes on either side.
   size_t target_neighbours = 2;
   /// Two verified candidates that place the keyframe this far apart are ambiguous.

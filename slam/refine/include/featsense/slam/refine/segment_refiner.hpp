@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cstddef>
 #include <deque>
 #include <string>
@@ -23,15 +24,29 @@
 
 namespace featsense::slam::refine {
 
+/// A stretch's registration: voxels of the target twice the points' spacing, then equal to it
+/// (finer ones would hold single points, with no surface to register to).
+inline VgicpSettings stretch_vgicp(double voxel_m) {
+  VgicpSettings settings;
+  settings.voxel_sizes_m = {2.0 * voxel_m, voxel_m};
+  settings.max_iterations = 32;
+  settings.step_tolerance_m = 5e-4;
+  settings.inlier_distance_m = 0.1;
+  settings.fitness_voxel_m = std::max(0.5, 2.0 * voxel_m);
+  return settings;
+}
+
+/// Where a setting has a config key (refine.*), its default is the configuration's
+/// (config/include/featsense/config/config.hpp): one home per default.
 struct RefineSettings {
   /// A stretch ends once the odometry has moved this far since the last final scan, metres.
-  double distance_m = 5.0;
+  double distance_m = config::RefineConfig{}.distance_m;
   /// ... or once it holds this many scans (a sensor standing still): bounds the latency and
   /// the scans held.
-  size_t max_scans = 64;
+  size_t max_scans = static_cast<size_t>(config::RefineConfig{}.max_scans);
   /// Each registered scan's points: one per voxel of this edge (refinement_cloud), metres,
   /// each with the covariance of this many nearest.
-  double voxel_m = 0.5;
+  double voxel_m = config::RefineConfig{}.voxel_m;
   int neighbours = 10;
   /// The target: this many scans of each stretch, evenly spaced along it, from the last
   /// target_stretches stretches (a longer memory drifts less from stretch to stretch).
@@ -44,7 +59,7 @@ struct RefineSettings {
   /// fitness (RMS distance) this fraction higher.
   double inlier_tolerance = 0.01;
   double fitness_tolerance = 0.05;
-  VgicpSettings vgicp = {{1.0, 0.5}, 32, 5e-4, 0.1, 1.0};
+  VgicpSettings vgicp = stretch_vgicp(config::RefineConfig{}.voxel_m);
 };
 
 /// refine.* of `config`.
