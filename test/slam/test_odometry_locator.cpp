@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "featsense/config/config.hpp"
-#include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/io/box_room_source.hpp"
+#include "featsense/slam/odometry/odometry_locator.hpp"
 
 namespace featsense::slam::odometry {
 namespace {

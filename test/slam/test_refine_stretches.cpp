@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "common/test_poses.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/refine/segment_refiner.hpp"
-#include "featsense/slam/io/box_room_source.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "scene_sampling.hpp"
