@@ -188,8 +188,9 @@ void MapPass::report_progress() {
   progress.total_frames = total_frames_;
   progress.integrating = settings_.integrate;
   if (store_ && store_->map) {
-    progress.shifts = store_->map->stats().shifts;
-    progress.chunks_written = store_->map->stats().chunks_written;
+    const storage::ShiftingMapStats& stats = store_->map->stats();
+    progress.shifts = stats.shifts;
+    progress.chunks_written = stats.chunks_written;
   }
   events_.progress(progress);
 }

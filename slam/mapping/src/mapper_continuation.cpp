@@ -57,12 +57,6 @@ std::vector<MapKeyframe> placed_keyframes(const LoopOutcome& loops,
   return out;
 }
 
-slam::Trajectory moved_by(const Eigen::Isometry3d& T, const slam::Trajectory& path) {
-  slam::Trajectory out;
-  for (size_t i = 0; i < path.size(); ++i) out.push_back(path.stamps_ns[i], T * path.poses[i]);
-  return out;
-}
-
 std::string not_placed_why(const RelocalizationReport& report, const LoopOutcome& loops,
                            const std::string& input) {
   const slam::loops::RelocalizationCounts& c = report.tried;

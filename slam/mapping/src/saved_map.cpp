@@ -59,6 +59,12 @@ void travelled_along_path(std::vector<slam::loops::MapKeyframe>& keyframes, size
     keyframes[k].travelled_m = travelled[nearest_pose(path, keyframes[k].stamp_ns)];
 }
 
+slam::Trajectory moved_by(const Eigen::Isometry3d& T, const slam::Trajectory& path) {
+  slam::Trajectory out;
+  for (size_t i = 0; i < path.size(); ++i) out.push_back(path.stamps_ns[i], T * path.poses[i]);
+  return out;
+}
+
 slam::Trajectory moved_path(const slam::Trajectory& path,
                             const std::vector<slam::loops::MapKeyframe>& keyframes, size_t first,
                             size_t end, const std::vector<Eigen::Isometry3d>& after) {

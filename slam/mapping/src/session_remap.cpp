@@ -12,12 +12,6 @@ namespace {
 namespace fs = std::filesystem;
 using slam::loops::MapKeyframe;
 
-slam::Trajectory moved_by(const Eigen::Isometry3d& T, const slam::Trajectory& path) {
-  slam::Trajectory out;
-  for (size_t i = 0; i < path.size(); ++i) out.push_back(path.stamps_ns[i], T * path.poses[i]);
-  return out;
-}
-
 }  // namespace
 
 std::string why_sessions_cannot_be_read(const SavedMap& saved, const config::Config& config) {

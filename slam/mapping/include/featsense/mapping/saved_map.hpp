@@ -51,6 +51,9 @@ std::vector<double> travelled_along(const slam::Trajectory& path);
 void travelled_along_path(std::vector<slam::loops::MapKeyframe>& keyframes, size_t first,
                           size_t end, const slam::Trajectory& path);
 
+/// Every pose of `path` moved rigidly by `T` (T * pose).
+slam::Trajectory moved_by(const Eigen::Isometry3d& T, const slam::Trajectory& path);
+
 /// `path` moved by the keyframes' moves (each keyframe's pose `before` -> `after`), spread
 /// between keyframes by the distance travelled (trajectory_correction.hpp).
 slam::Trajectory moved_path(const slam::Trajectory& path,
