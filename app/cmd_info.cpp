@@ -8,11 +8,14 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "featsense/bench/measurements.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
 #include "source_options.hpp"
 
 namespace featsense::app {
+
+using bench::min_median_max;
 namespace {
 
 struct InfoOptions {

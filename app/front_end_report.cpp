@@ -2,9 +2,13 @@
 
 #include <vector>
 
-#include "timing_stats.hpp"
+#include "featsense/bench/measurements.hpp"
 
 namespace featsense::app {
+
+using bench::summarize_ms;
+using bench::timing_json;
+using bench::TimingSummary;
 
 std::string intensity_fusion_text(const slam::odometry::OdometryCounts& counts, bool enabled) {
   if (!enabled) return "off (odometry.intensity_fusion = false)";

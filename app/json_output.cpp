@@ -1,7 +1,5 @@
 #include "json_output.hpp"
 
-#include "featsense/slam/trajectory/error_statistics.hpp"
-
 #include <algorithm>
 #include <fstream>
 #include <iostream>
@@ -25,11 +23,6 @@ void write_json(const nlohmann::json& document, const std::string& path) {
 void print_bench_result(const nlohmann::json& result, const std::optional<std::string>& json_path) {
   if (json_path && *json_path != "-") write_json(result, *json_path);
   std::cout << result.dump(2) << "\n";
-}
-
-nlohmann::json min_median_max(const std::vector<double>& values) {
-  const slam::ErrorStatistics statistics = slam::error_statistics(values);
-  return {{"min", statistics.min}, {"median", statistics.median}, {"max", statistics.max}};
 }
 
 }  // namespace featsense::app

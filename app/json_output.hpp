@@ -17,7 +17,4 @@ void write_json(const nlohmann::json& document, const std::string& path);
 /// absent or "-".
 void print_bench_result(const nlohmann::json& result, const std::optional<std::string>& json_path);
 
-/// {"min", "median", "max"} of the values (all 0 when empty).
-nlohmann::json min_median_max(const std::vector<double>& values);
-
 }  // namespace featsense::app

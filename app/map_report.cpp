@@ -1,18 +1,14 @@
 #include "map_report.hpp"
 
-#include <sys/resource.h>
-
 #include <map>
 
+#include "featsense/bench/measurements.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
-#include "timing_stats.hpp"
 
 namespace featsense::app {
-double peak_rss_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
-}
+
+using bench::peak_rss_mb;
+using bench::timing_json;
 
 nlohmann::json map_report_json(const config::Config& config, const slam::SourceInfo& input,
                                const mapping::MapResult& result) {

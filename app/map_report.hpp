@@ -21,7 +21,4 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
 /// stamps, placement and the number of keyframes it keeps.
 nlohmann::json sessions_json(const std::filesystem::path& path);
 
-/// Peak resident memory of this process so far, MB.
-double peak_rss_mb();
-
 }  // namespace featsense::app

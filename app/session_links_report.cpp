@@ -5,9 +5,11 @@
 #include <map>
 #include <string>
 
-#include "timing_stats.hpp"
+#include "featsense/bench/measurements.hpp"
 
 namespace featsense::app {
+
+using bench::timing_json;
 
 namespace {
 

@@ -1,11 +1,13 @@
-#include "timing_stats.hpp"
+#include "featsense/bench/measurements.hpp"
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "featsense/slam/trajectory/error_statistics.hpp"
 
-namespace featsense::app {
+namespace featsense::bench {
 
 TimingSummary summarize_ms(std::vector<double> samples_ms) {
   TimingSummary s;
@@ -30,4 +32,15 @@ nlohmann::json timing_json(const std::vector<double>& samples_ms) {
           {"mean_ms", s.mean_ms}, {"total_s", s.mean_ms * static_cast<double>(s.count) * 1e-3}};
 }
 
-}  // namespace featsense::app
+nlohmann::json min_median_max(const std::vector<double>& values) {
+  const slam::ErrorStatistics statistics = slam::error_statistics(values);
+  return {{"min", statistics.min}, {"median", statistics.median}, {"max", statistics.max}};
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+}  // namespace featsense::bench

@@ -1,4 +1,4 @@
-#include "synthetic_room_map.hpp"
+#include "featsense/bench/synthetic_hall.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -8,7 +8,7 @@
 
 #include "featsense/tsdf/voxel.hpp"
 
-namespace featsense::app {
+namespace featsense::bench {
 namespace {
 
 struct Box {
@@ -76,7 +76,7 @@ class Hall {
 
 }  // namespace
 
-storage::MemoryChunkStore make_room_map(const Eigen::Vector3d& size_m, double voxel_size_m,
+storage::MemoryChunkStore make_hall_map(const Eigen::Vector3d& size_m, double voxel_size_m,
                                         double truncation_m) {
   storage::MapMetadata metadata;
   metadata.voxel_size_m = voxel_size_m;
@@ -144,4 +144,4 @@ storage::MemoryChunkStore make_room_map(const Eigen::Vector3d& size_m, double vo
   return store;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::bench

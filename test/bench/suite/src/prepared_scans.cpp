@@ -1,11 +1,11 @@
-#include "bench_scans.hpp"
+#include "featsense/bench/prepared_scans.hpp"
 
 #include <optional>
 
 #include "featsense/mapping/scan_to_rays.hpp"
 #include "featsense/slam/io/box_room_source.hpp"
 
-namespace featsense::app {
+namespace featsense::bench {
 
 PreparedScans prepare_builtin(const std::string& scene, int count) {
   slam::BoxRoomSettings settings = slam::default_box_room();
@@ -35,20 +35,18 @@ PreparedScans prepare_builtin(const std::string& scene, int count) {
   return prepared;
 }
 
-PreparedScans prepare_recording(const InputOptions& input, const config::Config& config,
-                                int count) {
-  std::unique_ptr<slam::ScanSource> source = input.open(config);
+PreparedScans prepare_recording(slam::ScanSource& source, const std::string& name, int count) {
   PreparedScans prepared;
-  prepared.sensor = source->info().sensor;
-  prepared.description = source->info().format + " " + input.input + " (frames at the origin)";
+  prepared.sensor = source.info().sensor;
+  prepared.description = source.info().format + " " + name + " (frames at the origin)";
   while (static_cast<int>(prepared.rays.size()) < count) {
-    std::optional<slam::Scan> scan = source->next();
+    std::optional<slam::Scan> scan = source.next();
     if (!scan) break;
     prepared.rays.push_back(mapping::scan_to_rays(*scan, slam::ScanPlacement{}));
     prepared.input_points += prepared.rays.back().size();
   }
-  if (prepared.rays.empty()) throw slam::InputError(input.input + ": no readable frame");
+  if (prepared.rays.empty()) throw slam::InputError(name + ": no readable frame");
   return prepared;
 }
 
-}  // namespace featsense::app
+}  // namespace featsense::bench

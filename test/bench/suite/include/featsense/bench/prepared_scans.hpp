@@ -7,10 +7,10 @@
 
 #include "featsense/config/config.hpp"
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/slam/scan_source.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
-#include "source_options.hpp"
 
-namespace featsense::app {
+namespace featsense::bench {
 
 /// Scans as rays in the map frame, ready to integrate.
 struct PreparedScans {
@@ -24,7 +24,8 @@ struct PreparedScans {
 /// 120 x 80 m yard open to the sky ("outdoor": outdoor ranges, beams above the horizon lost).
 PreparedScans prepare_builtin(const std::string& scene, int count);
 
-/// The first `count` frames of a recording, each at the origin. Throws slam::InputError.
-PreparedScans prepare_recording(const InputOptions& input, const config::Config& config, int count);
+/// The first `count` frames of a recording, each at the origin; `name` says which in the
+/// description and the error. Throws slam::InputError when it gave no frame.
+PreparedScans prepare_recording(slam::ScanSource& source, const std::string& name, int count);
 
-}  // namespace featsense::app
+}  // namespace featsense::bench

@@ -1,13 +1,13 @@
 #pragma once
 // Per-stage timings in milliseconds and their summary (median / p95 / max), as every
-// report and benchmark prints them.
+// benchmark and every run's report gives them, and the process's peak memory.
 
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
 #include <vector>
 
-namespace featsense::app {
+namespace featsense::bench {
 
 struct TimingSummary {
   size_t count = 0;
@@ -23,4 +23,10 @@ TimingSummary summarize_ms(std::vector<double> samples_ms);
 /// The summary as reports print it: count, median_ms, p95_ms, max_ms, mean_ms, total_s.
 nlohmann::json timing_json(const std::vector<double>& samples_ms);
 
-}  // namespace featsense::app
+/// {"min", "median", "max"} of the values (all 0 when empty).
+nlohmann::json min_median_max(const std::vector<double>& values);
+
+/// The process's peak resident memory so far, MiB.
+double peak_rss_mb();
+
+}  // namespace featsense::bench

@@ -6,12 +6,12 @@
 
 #include "featsense/storage/memory_chunk_store.hpp"
 
-namespace featsense::app {
+namespace featsense::bench {
 
 /// A hall of `size_m` (x, y, z; centred on the origin in x and y, floor at z = -2 m so that
 /// chunk coordinates are negative too) with pillars, tables, crates and balls, voxels of
 /// `voxel_size_m`, weight 4 measurements everywhere observed. Built in parallel (TBB).
-storage::MemoryChunkStore make_room_map(const Eigen::Vector3d& size_m, double voxel_size_m,
+storage::MemoryChunkStore make_hall_map(const Eigen::Vector3d& size_m, double voxel_size_m,
                                         double truncation_m);
 
-}  // namespace featsense::app
+}  // namespace featsense::bench
