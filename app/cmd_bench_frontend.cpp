@@ -33,7 +33,7 @@ struct BenchFrontEndOptions {
 /// The benchmark's scans: the first --scans of --input, or a simulation of --scene along
 /// --path (or --trajectory), made outside the timed stages.
 struct OpenedScans {
-  std::unique_ptr<PreparedSimulation> simulation;  ///< what the scans refer to: keep it first
+  std::unique_ptr<slam::PreparedSimulation> simulation;  ///< what the scans refer to: keep it first
   std::unique_ptr<bench::BenchScans> scans;
 };
 
@@ -49,8 +49,8 @@ OpenedScans open_scans(const BenchFrontEndOptions& options, const config::Config
   simulate.path = options.trajectory_file.empty() ? options.path : "";
   simulate.trajectory_file = options.trajectory_file;
   simulate.frames = options.scans;
-  opened.simulation = std::make_unique<PreparedSimulation>(simulate);
-  const PreparedSimulation& simulation = *opened.simulation;
+  opened.simulation = std::make_unique<slam::PreparedSimulation>(simulation_request(simulate));
+  const slam::PreparedSimulation& simulation = *opened.simulation;
   const std::string description =
       "simulated " + options.scene + " scene, " +
       (options.trajectory_file.empty() ? options.path + " path"

@@ -104,7 +104,7 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   simulate.scene = options.scene;
   simulate.path = options.path;
   simulate.frames = options.frames;
-  const PreparedSimulation simulation(simulate);
+  const slam::PreparedSimulation simulation(simulation_request(simulate));
 
   const fs::path out(options.output);
   const fs::path truth = out / "ground_truth";

@@ -2,15 +2,10 @@
 // One simulation as a function, for `featsense simulate` and `featsense demo`.
 
 #include <cstdint>
-#include <memory>
 #include <string>
 
 #include "cli_context.hpp"
-#include "featsense/mesh/triangle_mesh.hpp"
-#include "featsense/slam/sim/lidar_simulator.hpp"
-#include "featsense/slam/sim/ray_caster.hpp"
-#include "featsense/slam/sim/trajectory.hpp"
-#include "featsense/slam/trajectory/trajectory.hpp"
+#include "featsense/slam/sim/prepared_simulation.hpp"
 
 namespace featsense::app {
 
@@ -32,23 +27,10 @@ struct SimulateOptions {
   int threads = 0;  ///< 0: all cores
 };
 
-/// The scene, the sensor's path and the simulator of `o`, checked and ready to produce frames.
-struct PreparedSimulation {
-  /// Throws ConfigError, InputError or std::invalid_argument naming the problem.
-  explicit PreparedSimulation(const SimulateOptions& o);
-  // The simulator refers to the mesh, caster and trajectory held here: never move them.
-  PreparedSimulation(const PreparedSimulation&) = delete;
-  PreparedSimulation& operator=(const PreparedSimulation&) = delete;
-
-  mesh::TriangleMesh mesh;
-  std::unique_ptr<slam::PoseCurve> trajectory;
-  std::unique_ptr<slam::RayCaster> caster;
-  std::unique_ptr<slam::LidarSimulator> simulator;
-  uint64_t frames = 0;  ///< o.frames, or all that the path holds
-
-  /// The true pose of each frame at its stamp (column 0's time), as gt_trajectory.tum holds.
-  slam::Trajectory frame_poses() const;
-};
+/// What `o` asks to simulate, its scene loaded where it is a mesh file (assimp: unit scale,
+/// up axis, surfaces only). Throws InputError for a scene that is neither a file nor a
+/// built-in scene's name.
+slam::SimulationRequest simulation_request(const SimulateOptions& o);
 
 /// Simulates the scene into o.output_dir (sequence.yaml, frames, ground truth). Throws
 /// ConfigError, InputError or std::runtime_error.
