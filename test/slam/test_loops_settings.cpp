@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/loops/relocalizer.hpp"
 #include "slam/settings_equality.hpp"
 
 namespace featsense::slam::loops {
@@ -36,6 +37,24 @@ TEST(LoopSettings, EveryKeyReachesItsSetting) {
   EXPECT_EQ(settings.min_inlier_fraction, 0.7);
   EXPECT_EQ(settings.drift_per_m, 0.05);
   EXPECT_FALSE(settings.gravity.enabled);
+}
+
+TEST(RelocalizeSettings, TheDefaultConfigurationGivesTheDefaults) {
+  const RelocalizeSettings configured = relocalize_from_config(config::Config{});
+  const RelocalizeSettings defaults;
+  EXPECT_EQ(configured.confirmations, defaults.confirmations);
+  EXPECT_EQ(configured.loop.min_inlier_fraction, defaults.loop.min_inlier_fraction);
+  EXPECT_EQ(configured.loop.max_fitness_m, defaults.loop.max_fitness_m);
+  test::expect_same_vgicp(configured.loop.vgicp, defaults.loop.vgicp);
+}
+
+TEST(RelocalizeSettings, ItsKeysAndTheLoopsReachTheirSettings) {
+  config::Config config;
+  config.relocalize.confirmations = 3;
+  config.loop.max_fitness_m = 0.2;
+  const RelocalizeSettings settings = relocalize_from_config(config);
+  EXPECT_EQ(settings.confirmations, 3u);
+  EXPECT_EQ(settings.loop.max_fitness_m, 0.2);
 }
 
 }  // namespace

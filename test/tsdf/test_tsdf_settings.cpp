@@ -1,4 +1,5 @@
-// The integrator's settings from the configuration and the sensor model.
+// The integrator's settings from the configuration and the sensor model; one home per
+// default: the default configuration gives TsdfSettings' own defaults.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,24 @@
 
 namespace featsense::tsdf {
 namespace {
+
+// TsdfSettings{} knows no sensor: it has neither the vertical interpolation nor sparse
+// carving, which come from the sensor's beam angles.
+TEST(TsdfSettings, TheDefaultConfigurationGivesTheDefaults) {
+  config::MapConfig map;
+  map.vertical_interpolation = false;
+  map.sparse_carving = false;
+  const TsdfSettings configured = TsdfSettings::from_config(map, config::sensor_preset("os1-128"));
+  const TsdfSettings defaults;
+  EXPECT_EQ(configured.voxel_size_m, defaults.voxel_size_m);
+  EXPECT_EQ(configured.truncation_m, defaults.truncation_m);
+  EXPECT_EQ(configured.max_weight, defaults.max_weight);
+  EXPECT_EQ(configured.map_size_m, defaults.map_size_m);
+  EXPECT_EQ(configured.interpolation_slope, defaults.interpolation_slope);
+  EXPECT_EQ(configured.reduce_points_per_voxel, defaults.reduce_points_per_voxel);
+  EXPECT_EQ(configured.dense_range_m, defaults.dense_range_m);
+  EXPECT_EQ(configured.carve_free_space, defaults.carve_free_space);
+}
 
 TEST(TsdfSettings, InterpolationFollowsTheSensorsBeamSpacingOrIsOff) {
   const config::SensorModel os1 = config::sensor_preset("os1-128");

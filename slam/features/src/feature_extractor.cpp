@@ -29,7 +29,7 @@ bool well_formed(const Scan& scan) {
 
 FeatureSettings from_config(const config::Config& config) {
   const config::FeaturesConfig& f = config.features;
-  FeatureSettings s{};
+  FeatureSettings s;
   s.neighbours = f.neighbours;
   s.sectors = f.sectors;
   s.max_edges_per_sector = f.max_edges_per_sector;

@@ -33,6 +33,13 @@ bool near_any(const std::vector<size_t>& chosen, const std::vector<Eigen::Isomet
 
 }  // namespace
 
+RelocalizeSettings relocalize_from_config(const config::Config& config) {
+  RelocalizeSettings settings;
+  settings.loop = from_config(config);
+  settings.confirmations = static_cast<size_t>(config.relocalize.confirmations);
+  return settings;
+}
+
 Relocalizer::Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings)
     : map_(std::move(map)), settings_(settings) {
   map_poses_.reserve(map_.size());

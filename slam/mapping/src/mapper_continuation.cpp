@@ -118,8 +118,7 @@ Mapper::Continuation::Continuation(const MapperSettings& settings, config::Confi
         "older featsense): a recording is placed in a map by its keyframes; continue it with "
         "--gt poses in its frame instead");
   }
-  settings_.loop = slam::loops::from_config(config);
-  settings_.confirmations = static_cast<size_t>(config.relocalize.confirmations);
+  settings_ = slam::loops::relocalize_from_config(config);
   settings_.guess = settings.initial_guess;
   relocalizer_ = std::make_unique<slam::loops::Relocalizer>(saved_.keyframes, settings_);
   max_scans_ = static_cast<size_t>(config.relocalize.max_scans);

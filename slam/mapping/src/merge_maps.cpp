@@ -38,9 +38,7 @@ MergeResult merge_maps(const std::string& first_path, const std::string& second_
   adopt_map_geometry(first.metadata, first_path, config, events);
 
   // B's keyframes, in order, against A's: the first that is confirmed places B.
-  slam::loops::RelocalizeSettings settings;
-  settings.loop = slam::loops::from_config(config);
-  settings.confirmations = static_cast<size_t>(config.relocalize.confirmations);
+  slam::loops::RelocalizeSettings settings = slam::loops::relocalize_from_config(config);
   slam::loops::Relocalizer relocalizer(first.keyframes, settings);
   for (const MapKeyframe& keyframe : second.keyframes) {
     if (relocalizer.add_keyframe(keyframe.stamp_ns, keyframe.T_map_sensor, keyframe.travelled_m,

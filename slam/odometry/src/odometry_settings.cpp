@@ -6,7 +6,6 @@ OdometrySettings from_config(const config::Config& config) {
   const config::OdometryConfig& c = config.odometry;
   OdometrySettings s;
   s.optimization_steps = c.optimization_steps;
-  s.solver_iterations = 4;
   s.edge_voxel_m = c.edge_voxel_m;
   s.surface_voxel_m = c.surface_voxel_m;
   s.map_radius_m = c.map_radius_m;

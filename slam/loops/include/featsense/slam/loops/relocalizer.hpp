@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "featsense/config/config.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/loops/map_keyframe.hpp"
 
@@ -36,7 +37,7 @@ struct RelocalizeSettings {
   size_t verifications = 4;
   /// Keyframes that must agree on the session's place, and how closely (plus the odometry's
   /// drift between them).
-  size_t confirmations = 2;
+  size_t confirmations = static_cast<size_t>(config::RelocalizeConfig{}.confirmations);
   double agreement_m = 0.5;
   double agreement_deg = 2.0;
   /// A user's guess of T_map_session, and how far the truth may lie from it.
@@ -44,6 +45,9 @@ struct RelocalizeSettings {
   double guess_radius_m = 10.0;
   size_t guess_candidates = 3;
 };
+
+/// loop.* and relocalize.confirmations of `config`; the rest as RelocalizeSettings{} has it.
+RelocalizeSettings relocalize_from_config(const config::Config& config);
 
 /// Why a candidate or a keyframe did not place the session.
 struct RelocalizationCounts {

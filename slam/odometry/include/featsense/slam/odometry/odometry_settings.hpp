@@ -1,27 +1,37 @@
 #pragma once
-/// The odometry's settings: plain fields, their defaults and reasons in config/default.yaml.
+/// The odometry's settings: plain fields, their defaults those of config.hpp, their reasons in
+/// config/default.yaml.
 
 #include "featsense/config/config.hpp"
 
 namespace featsense::slam::odometry {
 
+namespace detail {
+/// The odometry settings of config/default.yaml, where OdometrySettings' defaults come from.
+inline constexpr config::OdometryConfig kDefaultOdometry{};
+}  // namespace detail
+
+/// Default-constructed: the default configuration's (a test keeps from_config(Config{}) equal
+/// to it).
 struct OdometrySettings {
-  int optimization_steps = 0;  ///< outer loops: re-associate, then a few solver iterations
-  int solver_iterations = 0;   ///< Ceres iterations per outer loop
-  double edge_voxel_m = 0.0;
-  double surface_voxel_m = 0.0;
-  double map_radius_m = 0.0;
-  double max_correspondence_distance_m = 0.0;
-  double huber_loss_m = 0.0;
-  double degeneracy_threshold = 0.0;
-  double max_speed_m_s = 0.0;
-  double max_turn_rate_rad_s = 0.0;
+  /// Outer loops: re-associate, then a few solver iterations.
+  int optimization_steps = detail::kDefaultOdometry.optimization_steps;
+  /// Ceres iterations per outer loop, as F-LOAM; no key.
+  int solver_iterations = 4;
+  double edge_voxel_m = detail::kDefaultOdometry.edge_voxel_m;
+  double surface_voxel_m = detail::kDefaultOdometry.surface_voxel_m;
+  double map_radius_m = detail::kDefaultOdometry.map_radius_m;
+  double max_correspondence_distance_m = detail::kDefaultOdometry.max_correspondence_distance_m;
+  double huber_loss_m = detail::kDefaultOdometry.huber_loss_m;
+  double degeneracy_threshold = detail::kDefaultOdometry.degeneracy_threshold;
+  double max_speed_m_s = detail::kDefaultOdometry.max_speed_m_s;
+  double max_turn_rate_rad_s = detail::kDefaultOdometry.max_turn_rate_rad_s;
   /// Register the features deskewed to the scan's stamp with the motion being estimated
   /// (re-deskewed at every outer loop); false: as measured.
-  bool deskew = false;
+  bool deskew = detail::kDefaultOdometry.deskew;
 };
 
-/// The settings of config's odometry section (4 solver iterations per outer loop, as F-LOAM).
+/// The settings of config's odometry section.
 OdometrySettings from_config(const config::Config& config);
 
 }  // namespace featsense::slam::odometry
