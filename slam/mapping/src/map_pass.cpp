@@ -35,8 +35,9 @@ struct MapPass::Store {
   bool closed = false;
 };
 
-MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings, config::Config& config,
-                 const config::SensorModel& sensor, const MapStoreRequest& store, RunEvents events)
+MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings,
+                 const config::Config& config, const config::SensorModel& sensor,
+                 const MapStoreRequest& store, RunEvents events)
     : locator_(locator),
       settings_(settings),
       config_(config),
@@ -48,7 +49,7 @@ MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings, confi
   if (settings_.integrate) {
     store_ = std::make_unique<Store>();
     store_->files = open_map_store(request_.path, config_, request_.sensor_name,
-                                   request_.continue_from, request_.overwrite, events_);
+                                   request_.continue_from, request_.overwrite);
     result_.continued_chunks = store_->files.continued_chunks;
     store_->tsdf = tsdf::TsdfSettings::from_config(config_.map, sensor_);
   }

@@ -178,7 +178,7 @@ PassResult run_pipeline(slam::ScanSource& source, MapPass& pass, const PipelineS
 }
 
 PassResult run_pass(slam::ScanSource& source, slam::ScanLocator& locator,
-                    const PassSettings& settings, config::Config& config,
+                    const PassSettings& settings, const config::Config& config,
                     const MapStoreRequest& store, const RunEvents& events,
                     const PipelineSettings& pipeline) {
   MapPass pass(locator, settings, config, source.info().sensor, store, events);

@@ -33,6 +33,16 @@ std::string metres(double value) {
   return std::string(text, end);
 }
 
+/// A continued map's geometry must have been adopted before its store is opened.
+void check_geometry(const storage::MapMetadata& old_map, const std::string& what,
+                    const config::Config& config) {
+  if (same(config.map.voxel_size_m, old_map.voxel_size_m) &&
+      same(config.map.truncation_m, old_map.truncation_m))
+    return;
+  throw std::logic_error("the configuration does not hold the voxel size and tau of " + what +
+                         " (with_continued_geometry)");
+}
+
 /// Copies every chunk of `from` into `to`.
 size_t copy_chunks(storage::ChunkStore& from, storage::ChunkStore& to) {
   size_t copied = 0;
@@ -58,8 +68,8 @@ slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& po
   return trajectory;
 }
 
-void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
-                        config::Config& config, const RunEvents& events) {
+config::Config with_map_geometry(config::Config config, const storage::MapMetadata& old_map,
+                                 const std::string& what, const RunEvents& events) {
   const auto adopt = [&](const std::string& key, double& value, double old_value) {
     const auto given = config.explicit_keys.find(key);
     if (given != config.explicit_keys.end() && !same(value, old_value)) {
@@ -75,6 +85,20 @@ void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& 
   };
   adopt("map.voxel_size", config.map.voxel_size_m, old_map.voxel_size_m);
   adopt("map.truncation", config.map.truncation_m, old_map.truncation_m);
+  return config;
+}
+
+config::Config with_continued_geometry(config::Config config, const std::string& continue_from,
+                                       const RunEvents& events) {
+  const fs::path path(continue_from);
+  if (!fs::exists(path)) return config;
+  if (path.extension() == ".vdb")
+    return with_map_geometry(std::move(config), storage::read_vdb_metadata(path), continue_from,
+                             events);
+  storage::Hdf5ChunkStore old_map(path);
+  const storage::MapMetadata metadata = old_map.metadata();
+  old_map.close();
+  return with_map_geometry(std::move(config), metadata, continue_from, events);
 }
 
 void build_then_replace(const fs::path& partial, const fs::path& target,
@@ -117,10 +141,9 @@ std::vector<storage::TrajectoryPose> to_store_poses(const slam::Trajectory& traj
   return poses;
 }
 
-MapStore open_map_store(const fs::path& path, config::Config& config,
+MapStore open_map_store(const fs::path& path, const config::Config& config,
                         const std::string& sensor_name,
-                        const std::optional<std::string>& continue_from, bool overwrite,
-                        const RunEvents& events) {
+                        const std::optional<std::string>& continue_from, bool overwrite) {
   MapStore result;
   const storage::OpenMode create =
       overwrite ? storage::OpenMode::kCreateOverwrite : storage::OpenMode::kCreate;
@@ -140,7 +163,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   const bool in_place = fs::exists(path) && fs::equivalent(old_path, path);
   if (old_path.extension() == ".vdb") {
     // A .vdb carries voxel size and tau; the rest of the metadata comes from this run.
-    adopt_map_geometry(storage::read_vdb_metadata(old_path), old_path.string(), config, events);
+    check_geometry(storage::read_vdb_metadata(old_path), old_path.string(), config);
     result.store =
         std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));
     result.continued_chunks = storage::import_vdb(old_path, *result.store).chunks;
@@ -148,7 +171,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
   }
   if (in_place) {
     storage::Hdf5ChunkStore probe(old_path);
-    adopt_map_geometry(probe.metadata(), old_path.string(), config, events);
+    check_geometry(probe.metadata(), old_path.string(), config);
     result.earlier_poses = from_store_poses(probe.read_trajectory());
     result.continued_chunks = probe.keys().size();
     probe.close();
@@ -160,7 +183,7 @@ MapStore open_map_store(const fs::path& path, config::Config& config,
     throw std::runtime_error(path.string() + " exists; pass --overwrite to replace it");
   }
   storage::Hdf5ChunkStore old_map(old_path);
-  adopt_map_geometry(old_map.metadata(), old_path.string(), config, events);
+  check_geometry(old_map.metadata(), old_path.string(), config);
   result.earlier_poses = from_store_poses(old_map.read_trajectory());
   result.store =
       std::make_unique<storage::Hdf5ChunkStore>(path, create, metadata_of(config, sensor_name));

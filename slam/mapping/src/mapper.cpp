@@ -30,8 +30,18 @@ fs::path beside(const fs::path& map_path, const std::string& what) {
 
 Mapper::Mapper(MapperSettings settings, RunEvents events)
     : settings_(std::move(settings)), events_(std::move(events)) {
-  config::Config& config = settings_.config;
   const bool continuing_by_keyframes = settings_.continue_from && !settings_.given_poses;
+  // A continued map keeps its voxel size and tau: decided here, once, before anything opens.
+  if (continuing_by_keyframes) {
+    continuation_ = std::make_unique<Continuation>(settings_, events_);
+    settings_.config =
+        with_map_geometry(std::move(settings_.config), continuation_->saved_metadata(),
+                          *settings_.continue_from, events_);
+  } else if (settings_.continue_from) {
+    settings_.config =
+        with_continued_geometry(std::move(settings_.config), *settings_.continue_from, events_);
+  }
+  const config::Config& config = settings_.config;
   if (settings_.given_poses) {
     given_ =
         slam::make_given_pose_locator(std::move(*settings_.given_poses), config.odometry.deskew);
@@ -53,7 +63,6 @@ Mapper::Mapper(MapperSettings settings, RunEvents events)
 
   if (continuing_by_keyframes) {
     // Placed by its keyframes first: nothing is written until then.
-    continuation_ = std::make_unique<Continuation>(settings_, config, events_);
     PassSettings first = pass_settings_;
     first.integrate = false;
     if (!first.loops) first.loops = continuation_->relocalize_settings().loop;
@@ -120,7 +129,7 @@ void Mapper::second_pass(MapResult& result) {
   events_.info(std::to_string(loops.loops.size()) + " loops closed" +
                (loops.gravity.observations > 0 ? ", levelled by gravity" : "") +
                ": mapping the recording again with the corrected poses");
-  config::Config& config = settings_.config;
+  const config::Config& config = settings_.config;
   const fs::path replay_path = beside(settings_.map_path, "corrected");
   try {
     build_then_replace(replay_path, settings_.map_path, [&] {

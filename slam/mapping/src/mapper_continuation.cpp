@@ -90,8 +90,7 @@ void largest_move(const std::vector<MapKeyframe>& keyframes, size_t end,
 
 }  // namespace
 
-Mapper::Continuation::Continuation(const MapperSettings& settings, config::Config& config,
-                                   const RunEvents& events) {
+Mapper::Continuation::Continuation(const MapperSettings& settings, const RunEvents& events) {
   const fs::path old_map(*settings.continue_from);
   const fs::path& map_out = settings.map_path;
   if (old_map.extension() == ".vdb") {
@@ -110,7 +109,6 @@ Mapper::Continuation::Continuation(const MapperSettings& settings, config::Confi
         "then the map): this input cannot be read twice");
   }
   saved_ = read_saved_map(old_map);
-  adopt_map_geometry(saved_.metadata, old_map.string(), config, events);
   if (saved_.keyframes.empty()) {
     throw std::runtime_error(
         old_map.string() +
@@ -118,10 +116,10 @@ Mapper::Continuation::Continuation(const MapperSettings& settings, config::Confi
         "older featsense): a recording is placed in a map by its keyframes; continue it with "
         "--gt poses in its frame instead");
   }
-  settings_ = slam::loops::relocalize_from_config(config);
+  settings_ = slam::loops::relocalize_from_config(settings.config);
   settings_.guess = settings.initial_guess;
   relocalizer_ = std::make_unique<slam::loops::Relocalizer>(saved_.keyframes, settings_);
-  max_scans_ = static_cast<size_t>(config.relocalize.max_scans);
+  max_scans_ = static_cast<size_t>(settings.config.relocalize.max_scans);
   events.info("placing " + settings.session.input + " in " + old_map.string() + " by its " +
               std::to_string(saved_.keyframes.size()) + " keyframes (" +
               std::to_string(saved_.sessions.size()) + " sessions)" +
@@ -219,7 +217,7 @@ Mapper::Continuation::Placed Mapper::Continuation::place(const Mapper& mapper, M
 
 void Mapper::Continuation::map_placed(Mapper& mapper, MapResult& result, const Placed& placed) {
   const MapperSettings& request = mapper.settings_;
-  config::Config& config = mapper.settings_.config;
+  const config::Config& config = mapper.settings_.config;
   const RunEvents& events = mapper.events_;
   const std::string old_map = *request.continue_from;
   const RelocalizationReport& report = *result.relocalization;

@@ -19,9 +19,11 @@ namespace featsense::mapping {
 
 class Mapper::Continuation {
  public:
-  /// Checks the request and reads the saved map; `config` takes its voxel size and tau.
-  Continuation(const MapperSettings& settings, config::Config& config, const RunEvents& events);
+  /// Checks the request and reads the saved map (whose voxel size and tau the Mapper then
+  /// adopts: saved_metadata()).
+  Continuation(const MapperSettings& settings, const RunEvents& events);
 
+  const storage::MapMetadata& saved_metadata() const { return saved_.metadata; }
   const slam::loops::RelocalizeSettings& relocalize_settings() const { return settings_; }
   /// The relocalization as a stage of the first pass.
   RelocalizeStage stage() { return RelocalizeStage{relocalizer_.get(), max_scans_}; }

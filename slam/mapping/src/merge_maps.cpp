@@ -31,11 +31,11 @@ SavedMap read_map_to_merge(const std::string& path, const config::Config& config
 }  // namespace
 
 MergeResult merge_maps(const std::string& first_path, const std::string& second_path,
-                       const std::filesystem::path& output, config::Config& config,
+                       const std::filesystem::path& output, config::Config config,
                        const RunEvents& events) {
   const SavedMap first = read_map_to_merge(first_path, config);
   const SavedMap second = read_map_to_merge(second_path, config);
-  adopt_map_geometry(first.metadata, first_path, config, events);
+  config = with_map_geometry(std::move(config), first.metadata, first_path, events);
 
   // B's keyframes, in order, against A's: the first that is confirmed places B.
   slam::loops::RelocalizeSettings settings = slam::loops::relocalize_from_config(config);

@@ -58,7 +58,7 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
 }
 
 void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
-                    const PassSettings& replay, config::Config& config,
+                    const PassSettings& replay, const config::Config& config,
                     const std::string& sensor_name, const RunEvents& events) {
   for (size_t s = 0; s < sessions.size(); ++s) {
     const SessionRemap& session = sessions[s];

@@ -59,7 +59,7 @@ void add_odometry_figures(const slam::odometry::OdometryCounts& counts, nlohmann
 /// The front end as `featsense map` runs it, poses only, one scan at a time: the product's
 /// odometry locator, and with --refine / --loops the map pass's own refinement and loop
 /// stages (slam/mapping). The scans are simulated outside the clock.
-nlohmann::json bench_odometry(config::Config config, BenchScans& scans,
+nlohmann::json bench_odometry(const config::Config& config, BenchScans& scans,
                               const OdometryBenchSettings& options) {
   const std::unique_ptr<slam::odometry::OdometryLocator> odometry =
       slam::odometry::make_odometry_locator(config);

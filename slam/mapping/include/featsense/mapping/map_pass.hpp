@@ -72,10 +72,10 @@ struct LocatedScan {
 
 class MapPass {
  public:
-  /// Opens the store of `store` (not with settings.integrate false); `config` takes a
-  /// continued map's voxel size and tau. `sensor` gives the TSDF its beams (vertical
-  /// interpolation). `locator` must outlive the pass.
-  MapPass(slam::ScanLocator& locator, const PassSettings& settings, config::Config& config,
+  /// Opens the store of `store` (not with settings.integrate false); `config` holds a
+  /// continued map's voxel size and tau already (with_continued_geometry). `sensor` gives the
+  /// TSDF its beams (vertical interpolation). `locator` and `config` must outlive the pass.
+  MapPass(slam::ScanLocator& locator, const PassSettings& settings, const config::Config& config,
           const config::SensorModel& sensor, const MapStoreRequest& store, RunEvents events);
   ~MapPass();
   MapPass(const MapPass&) = delete;
@@ -130,7 +130,7 @@ class MapPass {
 
   slam::ScanLocator& locator_;
   PassSettings settings_;
-  config::Config& config_;
+  const config::Config& config_;
   config::SensorModel sensor_;
   MapStoreRequest request_;
   RunEvents events_;

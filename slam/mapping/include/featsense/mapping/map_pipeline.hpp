@@ -45,9 +45,9 @@ PassResult run_pipeline(slam::ScanSource& source, MapPass& pass,
                         const PipelineSettings& settings = {});
 
 /// A whole pass over `source` with `locator`: made (the store of `store` opened), run by the
-/// pipeline and closed. `config` takes a continued map's voxel size and tau.
+/// pipeline and closed. `config` holds a continued map's voxel size and tau already.
 PassResult run_pass(slam::ScanSource& source, slam::ScanLocator& locator,
-                    const PassSettings& settings, config::Config& config,
+                    const PassSettings& settings, const config::Config& config,
                     const MapStoreRequest& store, const RunEvents& events,
                     const PipelineSettings& pipeline = {});
 

@@ -23,19 +23,23 @@ struct MapStore {
 
 /// Creates `path` for a map of `config` (an existing file is an error unless `overwrite`),
 /// or, with `continue_from`, a copy of that map at `path` (in place when it is `path`).
-/// With `continue_from`, config.map.voxel_size and map.truncation are set to the old map's;
-/// a configuration that set either explicitly (config.explicit_keys) to another value, the
-/// default included, is a ConfigError naming both.
-MapStore open_map_store(const std::filesystem::path& path, config::Config& config,
+/// With `continue_from`, `config` must hold the old map's voxel size and tau already
+/// (with_continued_geometry); std::logic_error where it does not.
+MapStore open_map_store(const std::filesystem::path& path, const config::Config& config,
                         const std::string& sensor_name,
-                        const std::optional<std::string>& continue_from, bool overwrite,
-                        const RunEvents& events = {});
+                        const std::optional<std::string>& continue_from, bool overwrite);
 
-/// The old map's voxel size and tau (`what` names it) win over values that were not set; a
-/// value set explicitly (config file, --set or an option), even to the default, must be the
-/// old map's, else ConfigError naming both.
-void adopt_map_geometry(const storage::MapMetadata& old_map, const std::string& what,
-                        config::Config& config, const RunEvents& events = {});
+/// `config` with the old map's voxel size and tau (`what` names it) where they were not set;
+/// a value set explicitly (config file, --set or an option), even to the default, must be
+/// the old map's, else ConfigError naming both. A map keeps its geometry: this is decided
+/// once, before a run opens anything.
+config::Config with_map_geometry(config::Config config, const storage::MapMetadata& old_map,
+                                 const std::string& what, const RunEvents& events = {});
+
+/// with_map_geometry of the map at `continue_from` (.h5 or .vdb); `config` as it is where no
+/// such file exists (opening the store says so).
+config::Config with_continued_geometry(config::Config config, const std::string& continue_from,
+                                       const RunEvents& events = {});
 
 /// The trajectory of a store's poses.
 slam::Trajectory from_store_poses(const std::vector<storage::TrajectoryPose>& poses);

@@ -28,11 +28,11 @@ struct MergeResult {
 };
 
 /// Reads A and B (each must keep keyframes and name inputs that can be read again), places B
-/// in A and writes the merged map to `output` (replaced only once complete). `config` takes
-/// A's voxel size and tau. Throws std::runtime_error naming the problem; where B cannot be
-/// placed, returns the result without a placement and writes nothing.
+/// in A and writes the merged map to `output` (replaced only once complete), with A's voxel
+/// size and tau (with_map_geometry of `config`). Throws std::runtime_error naming the problem;
+/// where B cannot be placed, returns the result without a placement and writes nothing.
 MergeResult merge_maps(const std::string& first, const std::string& second,
-                       const std::filesystem::path& output, config::Config& config,
+                       const std::filesystem::path& output, config::Config config,
                        const RunEvents& events = {});
 
 }  // namespace featsense::mapping

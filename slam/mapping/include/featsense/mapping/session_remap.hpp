@@ -52,7 +52,7 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
 /// in order, into `into` (replaced). Throws Interrupted, slam::InputError or
 /// std::runtime_error.
 void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
-                    const PassSettings& replay, config::Config& config,
+                    const PassSettings& replay, const config::Config& config,
                     const std::string& sensor_name, const RunEvents& events);
 
 /// A keyframe by session and index, for reports of links between sessions.

@@ -29,7 +29,7 @@ struct OdometryBenchSettings {
 
 /// The product's odometry locator over every scan in order: per-stage ms, features per scan,
 /// degenerate and failed scans, and the trajectory's error where the truth is known.
-nlohmann::json bench_odometry(config::Config config, BenchScans& scans,
+nlohmann::json bench_odometry(const config::Config& config, BenchScans& scans,
                               const OdometryBenchSettings& settings);
 
 }  // namespace featsense::bench
