@@ -35,6 +35,13 @@ struct MapPass::Store {
   bool closed = false;
 };
 
+PassSettings pass_settings(const config::Config& config) {
+  PassSettings settings;
+  settings.flush_interval_s = config.map.flush_interval_s;
+  settings.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
+  return settings;
+}
+
 MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings,
                  const config::Config& config, const config::SensorModel& sensor,
                  const MapStoreRequest& store, RunEvents events)

@@ -54,8 +54,7 @@ Mapper::Mapper(MapperSettings settings, RunEvents events)
                                                                   : settings_.T_map_first_scan);
     locator_ = odometry_.get();
   }
-  pass_settings_.flush_interval_s = config.map.flush_interval_s;
-  pass_settings_.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
+  pass_settings_ = pass_settings(config);
   pass_settings_.integrate = settings_.integrate;
   if (odometry_ && config.refine.enabled) pass_settings_.refine = slam::refine::from_config(config);
   loops_off_because_ = loop_closure_off_because(odometry_ != nullptr, config);

@@ -86,9 +86,7 @@ MergeResult merge_maps(const std::string& first_path, const std::string& second_
        session_remaps(second, keyframes, first_second, offset, placement.T_map_session,
                       linked.poses, "; merged into " + first_path + " (relocalized)"))
     result.sessions.push_back(std::move(remap));
-  PassSettings replay;
-  replay.flush_interval_s = config.map.flush_interval_s;
-  replay.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
+  const PassSettings replay = pass_settings(config);
   const std::filesystem::path partial = std::filesystem::path(output.string() + ".partial");
   build_then_replace(partial, output, [&] {
     remap_sessions(result.sessions, partial, replay, config, first.metadata.sensor, events);

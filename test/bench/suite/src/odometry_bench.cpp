@@ -63,9 +63,8 @@ nlohmann::json bench_odometry(const config::Config& config, BenchScans& scans,
                               const OdometryBenchSettings& options) {
   const std::unique_ptr<slam::odometry::OdometryLocator> odometry =
       slam::odometry::make_odometry_locator(config);
-  mapping::PassSettings stages;
+  mapping::PassSettings stages = mapping::pass_settings(config);
   stages.integrate = false;
-  stages.drop_mixed_pixels = config.sensor.drop_mixed_pixels;
   if (options.refine) stages.refine = slam::refine::from_config(config);
   if (options.loops) stages.loops = slam::loops::from_config(config);
   mapping::MapPass pass(*odometry, stages, config, config::SensorModel{}, {}, {});

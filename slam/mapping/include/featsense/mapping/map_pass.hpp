@@ -45,8 +45,8 @@ struct MapStoreRequest {
 
 /// What a pass does with each scan besides placing it.
 struct PassSettings {
-  double flush_interval_s = config::MapConfig{}.flush_interval_s;  ///< map.flush_interval
-  bool drop_mixed_pixels = true;                                   ///< sensor.drop_mixed_pixels
+  double flush_interval_s = config::MapConfig{}.flush_interval_s;     ///< map.flush_interval
+  bool drop_mixed_pixels = config::SensorConfig{}.drop_mixed_pixels;  ///< sensor.drop_mixed_pixels
   /// Refine the locator's poses before they are mapped (refine.*; for odometry).
   std::optional<slam::refine::RefineSettings> refine;
   /// Close loops over the final poses (loop.*; for odometry): keyframes, verification, the
@@ -57,6 +57,10 @@ struct PassSettings {
   /// False: the poses only, nothing integrated and no store opened.
   bool integrate = true;
 };
+
+/// map.flush_interval and sensor.drop_mixed_pixels of `config`: a pass that integrates, with
+/// neither refinement nor loops (the Mapper adds those where they run).
+PassSettings pass_settings(const config::Config& config);
 
 /// A scan with its place, on its way to becoming rays.
 struct PlacedScan {

@@ -14,9 +14,9 @@ namespace featsense::slam {
 struct SourceOptions {
   std::optional<std::string> meta_path;  ///< Ouster metadata JSON (else found beside the pcap)
   std::optional<std::string> topic;      ///< ROS bag topic (else the one scan topic there is)
-  std::string sensor_preset = "auto";    ///< config key sensor.preset
-  std::optional<double> min_range_m;     ///< config key sensor.min_range (else the sensor's)
-  std::optional<double> max_range_m;     ///< config key sensor.max_range (else the sensor's)
+  std::string sensor_preset = config::SensorConfig{}.preset;  ///< config key sensor.preset
+  std::optional<double> min_range_m;  ///< config key sensor.min_range (else the sensor's)
+  std::optional<double> max_range_m;  ///< config key sensor.max_range (else the sensor's)
   /// Config key sensor.times_from_azimuth: clouds without a time field get per-point times
   /// from their points' azimuths (azimuth_times.hpp).
   bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth;
