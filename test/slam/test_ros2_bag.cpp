@@ -75,6 +75,54 @@ TEST(Ros2Bag, FolderAndSingleFileGiveTheClouds) {
   }
 }
 
+// Older rosbag2 versions left serialization_format empty; the messages are CDR all the same.
+TEST(Ros2Bag, AnEmptySerializationFormatMeansCdr) {
+  const auto dir = test::scratch_dir("ros2_empty_format");
+  test::write_sqlite_bag(dir / "empty.db3", {{kTopic, kCloudType, ""}}, cloud_messages(0, 3));
+  test::write_sqlite_bag(dir / "cdr.db3", {{kTopic, kCloudType, "cdr"}}, cloud_messages(0, 3));
+  std::unique_ptr<ScanSource> empty = open_scan_source((dir / "empty.db3").string());
+  std::unique_ptr<ScanSource> cdr = open_scan_source((dir / "cdr.db3").string());
+  EXPECT_EQ(empty->info().topics, cdr->info().topics);
+  for (int i = 0; i < 3; ++i) {
+    const std::optional<Scan> a = empty->next();
+    const std::optional<Scan> b = cdr->next();
+    ASSERT_TRUE(a && b) << "scan " << i;
+    test::expect_reference_scan(*a, spec_of(i), 1e-6);
+    EXPECT_EQ(a->stamp_ns, b->stamp_ns);
+    EXPECT_EQ(a->xyz, b->xyz);
+    EXPECT_EQ(a->valid, b->valid);
+  }
+  EXPECT_FALSE(empty->next());
+  EXPECT_EQ(empty->stats().warning_count, 0u);
+}
+
+// A bag converted from ROS 1 says "ros1": its messages are read as ROS 1 serializes them.
+TEST(Ros2Bag, ARos1SerializedTopicIsReadAsRos1) {
+  const auto dir = test::scratch_dir("ros2_ros1_format");
+  std::vector<TestMessage> messages;
+  for (int i = 0; i < 2; ++i) {
+    const CloudSpec spec = spec_of(i);
+    messages.push_back(
+        {kTopic, spec.stamp_ns + 5000000, test::make_reference_cloud(spec).serialize()});
+  }
+  test::write_sqlite_bag(dir / "bag.db3", {{kTopic, kCloudType, "ros1"}}, messages);
+  std::unique_ptr<ScanSource> source = open_scan_source((dir / "bag.db3").string());
+  EXPECT_EQ(expect_reference_scans(*source, 2), 2u);
+  EXPECT_EQ(source->stats().warning_count, 0u);
+}
+
+// A serialization that is neither CDR nor ROS 1 is never decoded as a scan, and named.
+TEST(Ros2Bag, AnUnknownSerializationIsNamedNotDecoded) {
+  const auto dir = test::scratch_dir("ros2_unknown_format");
+  test::write_sqlite_bag(dir / "bag.db3", {{kTopic, kCloudType, "json"}}, cloud_messages(0, 1));
+  try {
+    open_scan_source((dir / "bag.db3").string());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("json serialization"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Ros2Bag, SplitBagIsReadFileByFile) {
   const auto dir = test::scratch_dir("ros2_split");
   test::write_sqlite_bag(dir / "bag_0.db3", {{kTopic, kCloudType}}, cloud_messages(0, 2));

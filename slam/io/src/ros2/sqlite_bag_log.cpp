@@ -4,12 +4,23 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "rosbag/bag_topic_choice.hpp"
 
 namespace featsense::slam {
 namespace {
+
+/// How a rosbag2 topic's messages are serialized, from the topics table's
+/// serialization_format: "cdr", and the empty string that older rosbag2 versions wrote, mean
+/// CDR (what every ROS 2 middleware serializes to; each message's encapsulation header then
+/// gives its byte order); "ros1" is a bag converted from ROS 1. Anything else is not read.
+std::optional<MessageEncoding> rosbag2_encoding(const std::string& format) {
+  if (format.empty() || format == "cdr") return MessageEncoding::kCdr;
+  if (format == "ros1") return MessageEncoding::kRos1;
+  return std::nullopt;
+}
 
 /// Owns a connection; closed when the log goes.
 struct DatabaseCloser {
@@ -125,10 +136,13 @@ class SqliteBagLog final : public MessageLog {
       topic.name = column_text(topics.get(), 1);
       topic.type = ros1_style_type(column_text(topics.get(), 2));
       const std::string format = column_text(topics.get(), 3);
-      topic.encoding = format == "cdr" ? MessageEncoding::kCdr : MessageEncoding::kRos1;
-      if (format != "cdr") {
+      if (const std::optional<MessageEncoding> encoding = rosbag2_encoding(format)) {
+        topic.encoding = *encoding;
+      } else {
+        // Shown with its serialization, never decoded as a scan.
+        topic.type += " (" + format + " serialization)";
         catalog_.warnings.push_back(path_ + ": topic " + topic.name + " is serialized as '" +
-                                    format + "', read as ROS 1");
+                                    format + "', which is neither CDR nor ROS 1: not read");
       }
       by_id[sqlite3_column_int64(topics.get(), 0)] = std::move(topic);
     }
