@@ -26,11 +26,15 @@ double half_spacing_at(const std::vector<double>& elevation_rad, size_t beam) {
 
 /// The beam nearest to a point's elevation, found by slope z / horizontal distance (which
 /// grows with the elevation, so no arctangent per point): the beam boundaries are the
-/// slopes of the elevations halfway between neighbouring beams.
+/// slopes of the elevations halfway between neighbouring beams. The horizontal distance is
+/// counted from the beam origin (`beam_origin_offset_m` out from the lidar origin along the
+/// azimuth, as Ouster sensors have it): from the lidar origin, a point 1 m away on an
+/// OS1-128's top beam seems 0.35 degrees (a whole beam spacing) lower than its beam.
 class BeamLookup {
  public:
   /// `elevation_rad` from the highest beam to the lowest (SensorModel's order).
-  explicit BeamLookup(const std::vector<double>& elevation_rad) {
+  BeamLookup(const std::vector<double>& elevation_rad, double beam_origin_offset_m)
+      : offset_m_(beam_origin_offset_m) {
     const size_t beams = elevation_rad.size();
     if (beams == 0) return;
     top_ = slope(elevation_rad.front() + half_spacing_at(elevation_rad, 0));
@@ -44,7 +48,8 @@ class BeamLookup {
   /// spacing above the highest or below the lowest beam.
   int row_of(const Eigen::Vector3f& p) const {
     const double x = static_cast<double>(p.x()), y = static_cast<double>(p.y());
-    const double horizontal = std::sqrt(x * x + y * y);
+    double horizontal = std::sqrt(x * x + y * y);
+    if (horizontal > offset_m_) horizontal -= offset_m_;
     const double s = static_cast<double>(p.z()) / horizontal;  // +-inf straight up / down
     if (!(s <= top_ && s >= bottom_)) return -1;
     // Boundaries descend; the number of them above the point is its row (a point exactly
@@ -61,6 +66,7 @@ class BeamLookup {
     return std::tan(elevation_rad);
   }
 
+  double offset_m_ = 0.0;
   std::vector<double> boundaries_;
   double top_ = 0.0;
   double bottom_ = 0.0;
@@ -104,7 +110,8 @@ Scan organize(const PointCloud& cloud, const config::SensorModel& sensor, Organi
   }
   OrganizeStats counts;
   counts.input_points = cloud.size();
-  const BeamLookup beams(by_ring ? std::vector<double>() : sensor.elevation_rad);
+  const BeamLookup beams(by_ring ? std::vector<double>() : sensor.elevation_rad,
+                         sensor.beam_origin_offset_m);
 
   Scan scan = Scan::allocate(sensor.beams, sensor.columns);
   std::vector<ScanChannel*> channels;

@@ -1,7 +1,10 @@
 #include "cloud/cloud_file_io.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <system_error>
+
+#include "cloud/sensor_guess.hpp"
 
 namespace featsense::slam::cloud {
 
@@ -57,6 +60,26 @@ std::string describe(const OrganizeStats& stats, std::vector<std::string>* warni
   return std::to_string(stats.input_points) + " points, " + std::to_string(stats.dropped_invalid) +
          " empty (zero or NaN), " + std::to_string(stats.dropped_outside) + " outside the beams, " +
          std::to_string(stats.dropped_collisions) + " in occupied cells";
+}
+
+void check_sensor_fits(const OrganizeStats& stats, const PointCloud& cloud,
+                       const config::SensorModel& sensor, const std::string& origin) {
+  const size_t returns = stats.input_points - stats.dropped_invalid;
+  // A model that fits loses next to nothing above its highest or below its lowest beam (the
+  // half beam spacing beyond them is kept); a fifth of every scan is never a fit.
+  if (returns == 0 || 5 * stats.dropped_outside <= returns) return;
+  const std::vector<std::string> fitting = presets_fitting_elevations(cloud);
+  std::string presets;
+  for (const std::string& name : fitting) presets += (presets.empty() ? "" : ", ") + name;
+  const long percent = std::lround(100.0 * static_cast<double>(stats.dropped_outside) /
+                                   static_cast<double>(returns));
+  throw InputError(origin + ": " + std::to_string(percent) + " % of the points (" +
+                   std::to_string(stats.dropped_outside) + " of " + std::to_string(returns) +
+                   ") lie outside the beams of sensor " + sensor.name + "; " +
+                   (fitting.empty() ? std::string("they lie on no preset's beams either: set "
+                                                  "sensor.preset to the sensor that recorded them")
+                                    : "presets whose beams they lie on: " + presets +
+                                          " (--set sensor.preset=NAME)"));
 }
 
 }  // namespace featsense::slam::cloud

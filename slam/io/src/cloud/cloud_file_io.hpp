@@ -22,4 +22,10 @@ DecodedCloud decode_cloud_file(const std::filesystem::path& path, CloudFormat fo
 std::string describe(const OrganizeStats& stats, std::vector<std::string>* warnings,
                      const std::string& origin);
 
+/// Throws InputError where over a fifth of the points of a recording's first cloud lie outside
+/// the beams of `sensor` (a preset that does not fit, given or guessed): mapped, every scan would
+/// lose that share. The message names the share and the presets whose beams the points lie on.
+void check_sensor_fits(const OrganizeStats& stats, const PointCloud& cloud,
+                       const config::SensorModel& sensor, const std::string& origin);
+
 }  // namespace featsense::slam::cloud

@@ -31,6 +31,7 @@ class CloudFileSource final : public ScanSource {
     CloudTiming timing;
     timing.from_azimuth = options.times_from_azimuth;
     scan_ = cloud_to_scan(decoded, info_.sensor, path, &stats, &warnings, timing, &info_.times);
+    cloud::check_sensor_fits(stats, decoded.cloud, info_.sensor, path);
     info_.detail = cloud::describe(stats, &warnings, path) + "; sensor " + why;
     for (const std::string& w : warnings) warn(w);
     // As in folders: a stamp in the name, else the one the file states, else 0.

@@ -171,7 +171,8 @@ config::SensorModel sensor_of_rows(const DecodedCloud& decoded, const SourceOpti
 }  // namespace
 
 config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptions& options,
-                                  const std::string& origin, std::string* why) {
+                                  const std::string& origin, std::string* why,
+                                  const std::string& unmatched_preset) {
   auto say = [why](const std::string& text) {
     if (why) *why = text;
   };
@@ -213,6 +214,11 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
   if (const auto name = cloud::preset_from_elevations(cloud)) {
     say("preset " + *name + " (points lie on its beam elevations)");
     return sensor_for(options, *name);
+  }
+  if (!unmatched_preset.empty()) {
+    say("preset " + unmatched_preset +
+        " (the points match no preset's beams; the format's usual sensor)");
+    return sensor_for(options, unmatched_preset);
   }
   throw InputError(origin +
                    ": an unorganized cloud without a ring field whose points match no preset's "

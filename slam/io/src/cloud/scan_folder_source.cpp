@@ -207,13 +207,9 @@ class ScanFolderSource final : public ScanSource {
       timing_.reference = SweepReference::kFacingForward;
     }
 
-    if (format_ == CloudFormat::kKittiBin) {
-      open_first_cloud(options, sensor_for(options, "hdl64"));
-      info_.detail =
-          std::to_string(frames_.size()) + " KITTI .bin scans, sensor " + info_.sensor.name;
-    } else {
-      open_first_cloud(options, std::nullopt);
-    }
+    // KITTI's own scans come from an HDL-64E; a .bin folder of another sensor's scans is told
+    // by the elevations its points lie on.
+    open_first_cloud(options, std::nullopt, format_ == CloudFormat::kKittiBin ? "hdl64" : "");
     rate_hz_ = info_.sensor.rate_hz;
   }
 
@@ -265,7 +261,8 @@ class ScanFolderSource final : public ScanSource {
   /// and a folder without any readable frame is an error. A sensor that cannot be chosen fails at
   /// once, as it would for every frame.
   void open_first_cloud(const SourceOptions& options,
-                        const std::optional<config::SensorModel>& known) {
+                        const std::optional<config::SensorModel>& known,
+                        const std::string& unmatched_preset = "") {
     std::string last_error;
     for (size_t i = 0; i < frames_.size(); ++i) {
       const std::string origin = frames_[i].file.string();
@@ -278,7 +275,8 @@ class ScanFolderSource final : public ScanSource {
         continue;
       }
       std::string why = "from " + (folder_ / "sequence.yaml").string();
-      info_.sensor = known ? *known : choose_sensor(decoded, options, origin, &why);
+      info_.sensor =
+          known ? *known : choose_sensor(decoded, options, origin, &why, unmatched_preset);
       OrganizeStats stats;
       std::vector<std::string> warnings;
       try {
@@ -289,6 +287,7 @@ class ScanFolderSource final : public ScanSource {
         skip_frame("frame skipped: " + last_error);
         continue;
       }
+      cloud::check_sensor_fits(stats, decoded.cloud, info_.sensor, origin);
       for (const std::string& w : decoded.warnings) warn(origin + ": " + w);
       cloud::describe(stats, &warnings, origin);
       for (const std::string& w : warnings) warn(w);

@@ -22,9 +22,13 @@ constexpr size_t kMaxSampledPoints = 20000;
 constexpr double kMinFitFraction = 0.9;
 constexpr double kMinBeamsHitFraction = 0.5;
 
-double elevation_of(const Eigen::Vector3f& p) {
+/// The elevation of `p` seen from the beam origin, `beam_origin_offset_m` out from the lidar
+/// origin along the point's azimuth (organize.cpp says why).
+double elevation_of(const Eigen::Vector3f& p, double beam_origin_offset_m = 0.0) {
   const Eigen::Vector3d q = p.cast<double>();
-  return std::atan2(q.z(), std::hypot(q.x(), q.y()));
+  double horizontal = std::hypot(q.x(), q.y());
+  if (horizontal > beam_origin_offset_m) horizontal -= beam_origin_offset_m;
+  return std::atan2(q.z(), horizontal);
 }
 
 double smallest_spacing(const std::vector<double>& elevation_rad) {
@@ -76,22 +80,24 @@ std::optional<std::string> preset_fitting_rows(const std::vector<std::optional<d
   return std::nullopt;
 }
 
-std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
-  std::vector<double> elevations;
+std::vector<std::string> presets_fitting_elevations(const PointCloud& cloud) {
+  std::vector<const Eigen::Vector3f*> sample;
   size_t data_points = 0;
   for (const Eigen::Vector3f& p : cloud.xyz) data_points += is_return(p) ? 1 : 0;
   const size_t step = std::max<size_t>(1, data_points / kMaxSampledPoints);
   size_t seen = 0;
   for (const Eigen::Vector3f& p : cloud.xyz) {
-    if (is_return(p) && seen++ % step == 0) elevations.push_back(elevation_of(p));
+    if (is_return(p) && seen++ % step == 0) sample.push_back(&p);
   }
-  if (elevations.empty()) return std::nullopt;
-
-  std::optional<std::string> best;
-  int fitting = 0;
+  std::vector<std::string> fitting;
+  if (sample.empty()) return fitting;
+  std::vector<double> elevations;
   for (const config::SensorModel& preset : builtin_presets()) {
     const std::vector<double>& beams = preset.elevation_rad;
     if (beams.empty()) continue;
+    elevations.clear();
+    for (const Eigen::Vector3f* p : sample)
+      elevations.push_back(elevation_of(*p, preset.beam_origin_offset_m));
     const double tolerance = 0.25 * smallest_spacing(beams);
     std::vector<char> hit(beams.size(), 0);
     size_t on_beam = 0;
@@ -109,12 +115,15 @@ std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
     const double fit = static_cast<double>(on_beam) / static_cast<double>(elevations.size());
     const double beams_hit = static_cast<double>(std::count(hit.begin(), hit.end(), 1)) /
                              static_cast<double>(beams.size());
-    if (fit >= kMinFitFraction && beams_hit >= kMinBeamsHitFraction) {
-      ++fitting;
-      best = preset.name;
-    }
+    if (fit >= kMinFitFraction && beams_hit >= kMinBeamsHitFraction) fitting.push_back(preset.name);
   }
-  return fitting == 1 ? best : std::nullopt;
+  return fitting;
+}
+
+std::optional<std::string> preset_from_elevations(const PointCloud& cloud) {
+  const std::vector<std::string> fitting = presets_fitting_elevations(cloud);
+  if (fitting.size() != 1) return std::nullopt;
+  return fitting.front();
 }
 
 namespace {

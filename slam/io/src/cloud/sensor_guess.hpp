@@ -25,6 +25,10 @@ std::optional<std::string> preset_with_beams(int beams);
 /// matches within a quarter of its smallest beam spacing, or nullopt.
 std::optional<std::string> preset_fitting_rows(const std::vector<std::optional<double>>& rows);
 
+/// Every preset on whose beam elevations (seen from its beam origin) at least 90 % of the
+/// cloud's points lie, with points on at least half of its beams, by name.
+std::vector<std::string> presets_fitting_elevations(const PointCloud& cloud);
+
 /// The preset on whose beam elevations at least 90 % of the cloud's points lie (within a
 /// quarter of its smallest beam spacing), with points on at least half of its beams; nullopt
 /// when no preset or more than one fits that well. Real sensors with per-unit calibrations

@@ -54,10 +54,13 @@ DecodedCloud decode_kitti_bin(std::string_view bytes, const std::string& origin)
 ///   columns = width either way;
 /// - a ring field: the smallest of vlp16 / hdl32 / hdl64 / os1-128 with beams > the largest
 ///   ring;
-/// - else the preset on whose beam elevations nearly all points lie (exact for simulated or
-///   nominally calibrated data), else InputError asking for `--set sensor.preset=NAME`.
+/// - else the preset on whose beam elevations nearly all points lie (seen from its beam
+///   origin; exact for simulated or nominally calibrated data), else `unmatched_preset` where
+///   one is given (a KITTI .bin folder: hdl64, whose per-unit calibration fits no preset
+///   exactly), else InputError asking for `--set sensor.preset=NAME`.
 config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptions& options,
-                                  const std::string& origin, std::string* why = nullptr);
+                                  const std::string& origin, std::string* why = nullptr,
+                                  const std::string& unmatched_preset = "");
 
 /// How cloud_to_scan() times the points of a cloud without a per-point time field.
 struct CloudTiming {
