@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,50 @@ TEST(SensorFromPoints, APresetThatDoesNotFitIsAnErrorNamingTheOneThatDoes) {
     EXPECT_NE(what.find("outside the beams of sensor hdl64"), std::string::npos) << what;
     EXPECT_NE(what.find("presets whose beams they lie on: os1-128"), std::string::npos) << what;
   }
+}
+
+// A sensor no preset describes (40 beams spaced unevenly from +7 to -16 degrees, 1800
+// columns: a Hesai Pandar40's layout) gets a model measured from its points: its beams at
+// their elevations, its columns, every point in its own cell.
+TEST(SensorFromPoints, ASensorNoPresetFitsIsMeasuredFromItsPoints) {
+  std::vector<double> elevation_deg;
+  for (int b = 0; b < 40; ++b) {
+    // Dense in the middle (0.33 deg), sparse at the ends (1 deg), as such sensors are.
+    elevation_deg.push_back(b < 5    ? 7.0 - b
+                            : b < 35 ? 2.0 - 0.33 * (b - 5)
+                                     : -8.0 - 1.6 * (b - 35));
+  }
+  constexpr int kColumns = 1800;
+  Scan truth = Scan::allocate(40, kColumns);
+  for (int r = 0; r < 40; ++r) {
+    for (int c = 0; c < kColumns; ++c) {
+      const double elevation = elevation_deg[static_cast<size_t>(r)] * M_PI / 180.0;
+      const double azimuth = -2.0 * M_PI * c / kColumns;  // column c centred there, clockwise
+      const double range = 5.0 + 20.0 * std::fabs(std::sin(0.37 * c + 1.3 * r));
+      const size_t i = truth.index(r, c);
+      truth.xyz[i] =
+          Eigen::Vector3f(static_cast<float>(range * std::cos(elevation) * std::cos(azimuth)),
+                          static_cast<float>(range * std::cos(elevation) * std::sin(azimuth)),
+                          static_cast<float>(range * std::sin(elevation)));
+      truth.range_m[i] = static_cast<float>(range);
+      truth.valid[i] = 1;
+    }
+  }
+  const fs::path dir = test::scratch_dir("sensor_from_points_measured");
+  write_scan_kitti_bin(truth, (dir / "000000.bin").string());
+  const auto source = open_scan_folder(dir.string(), SourceOptions{});
+  const config::SensorModel& sensor = source->info().sensor;
+  EXPECT_EQ(sensor.name, "measured-40-beams") << source->info().detail;
+  EXPECT_EQ(sensor.columns, kColumns);
+  ASSERT_EQ(sensor.elevation_rad.size(), 40u);
+  for (size_t b = 0; b < 40; ++b)
+    EXPECT_NEAR(sensor.elevation_rad[b] * 180.0 / M_PI, elevation_deg[b], 1e-3) << "beam " << b;
+  const std::optional<Scan> back = source->next();
+  ASSERT_TRUE(back);
+  size_t same_cell = 0;
+  for (size_t i = 0; i < truth.size(); ++i)
+    same_cell += back->valid[i] && (back->xyz[i] - truth.xyz[i]).norm() < 1e-4f ? 1 : 0;
+  EXPECT_GE(static_cast<double>(same_cell), 0.999 * static_cast<double>(truth.size()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, SensorFromPoints,

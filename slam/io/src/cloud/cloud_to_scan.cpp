@@ -215,6 +215,11 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
     say("preset " + *name + " (points lie on its beam elevations)");
     return sensor_for(options, *name);
   }
+  if (const std::optional<config::SensorModel> measured = cloud::sensor_from_elevations(cloud)) {
+    say(std::to_string(measured->beams) + " beams and " + std::to_string(measured->columns) +
+        " columns measured from the points (no preset fits them)");
+    return *measured;
+  }
   if (!unmatched_preset.empty()) {
     say("preset " + unmatched_preset +
         " (the points match no preset's beams; the format's usual sensor)");

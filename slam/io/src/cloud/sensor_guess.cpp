@@ -218,4 +218,92 @@ std::optional<config::SensorModel> sensor_from_rows(
   return model;
 }
 
+namespace {
+
+constexpr double kMinMeasuredRangeM = 2.0;
+constexpr double kBeamGapRad = 0.06 * M_PI / 180.0;
+constexpr int kMinMeasuredBeams = 8;
+constexpr int kMaxMeasuredBeams = 256;
+
+struct PolarPoint {
+  double elevation_rad;
+  double azimuth_rad;
+};
+
+/// Points at least kMinMeasuredRangeM away, every step-th, as elevation and azimuth.
+std::vector<PolarPoint> polar_sample(const PointCloud& cloud) {
+  std::vector<PolarPoint> points;
+  for (const Eigen::Vector3f& p : cloud.xyz) {
+    if (!is_return(p)) continue;
+    const double horizontal = std::hypot(static_cast<double>(p.x()), static_cast<double>(p.y()));
+    if (std::hypot(horizontal, static_cast<double>(p.z())) < kMinMeasuredRangeM) continue;
+    points.push_back(
+        {elevation_of(p), std::atan2(static_cast<double>(p.y()), static_cast<double>(p.x()))});
+  }
+  return points;
+}
+
+/// The median of the positive steps between the sorted azimuths: the column spacing.
+std::optional<double> azimuth_step(std::vector<double> azimuth_rad) {
+  if (azimuth_rad.size() < 16) return std::nullopt;
+  std::sort(azimuth_rad.begin(), azimuth_rad.end());
+  std::vector<double> steps;
+  for (size_t k = 1; k < azimuth_rad.size(); ++k) {
+    const double step = azimuth_rad[k] - azimuth_rad[k - 1];
+    if (step > 1e-6) steps.push_back(step);
+  }
+  if (steps.empty()) return std::nullopt;
+  auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), middle, steps.end());
+  return *middle;
+}
+
+}  // namespace
+
+std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& cloud) {
+  std::vector<PolarPoint> points = polar_sample(cloud);
+  if (points.size() < 1000) return std::nullopt;
+  std::sort(points.begin(), points.end(), [](const PolarPoint& a, const PolarPoint& b) {
+    return a.elevation_rad > b.elevation_rad;  // the highest beam first, as SensorModel
+  });
+  // Runs of elevations without a gap: the candidate beams.
+  std::vector<std::pair<size_t, size_t>> runs;  // [first, last)
+  size_t first = 0;
+  for (size_t k = 1; k <= points.size(); ++k) {
+    if (k == points.size() || points[k - 1].elevation_rad - points[k].elevation_rad > kBeamGapRad) {
+      runs.emplace_back(first, k);
+      first = k;
+    }
+  }
+  // A beam holds at least a fifth of the points of a typical one; fewer are strays between
+  // beams (mixed pixels, noise).
+  std::vector<size_t> sizes;
+  for (const auto& [a, b] : runs) sizes.push_back(b - a);
+  auto middle = sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2);
+  std::nth_element(sizes.begin(), middle, sizes.end());
+  const size_t min_points = std::max<size_t>(8, *middle / 5);
+  std::vector<std::optional<double>> elevation_rad;
+  std::vector<double> columns;
+  size_t on_beams = 0;
+  for (const auto& [a, b] : runs) {
+    if (b - a < min_points) continue;
+    on_beams += b - a;
+    elevation_rad.push_back(points[a + (b - a) / 2].elevation_rad);
+    std::vector<double> azimuths;
+    for (size_t k = a; k < b; ++k) azimuths.push_back(points[k].azimuth_rad);
+    if (const std::optional<double> step = azimuth_step(std::move(azimuths)))
+      columns.push_back(2.0 * M_PI / *step);
+  }
+  const int beams = static_cast<int>(elevation_rad.size());
+  if (beams < kMinMeasuredBeams || beams > kMaxMeasuredBeams || columns.empty() ||
+      static_cast<double>(on_beams) < kMinFitFraction * static_cast<double>(points.size()))
+    return std::nullopt;
+  auto column_middle = columns.begin() + static_cast<std::ptrdiff_t>(columns.size() / 2);
+  std::nth_element(columns.begin(), column_middle, columns.end());
+  std::optional<config::SensorModel> model =
+      sensor_from_rows(elevation_rad, static_cast<int>(std::lround(*column_middle)));
+  if (model) model->name = "measured-" + std::to_string(beams) + "-beams";
+  return model;
+}
+
 }  // namespace featsense::slam::cloud

@@ -35,6 +35,14 @@ std::vector<std::string> presets_fitting_elevations(const PointCloud& cloud);
 /// often fit none, which is the safe answer: the caller then asks the user.
 std::optional<std::string> preset_from_elevations(const PointCloud& cloud);
 
+/// A sensor model measured from an unorganized cloud's points, for a sensor no preset fits:
+/// the beams are the elevations the points gather on (points at least 2 m away, seen from the
+/// lidar origin, split where two neighbouring elevations lie more than 0.06 degrees apart),
+/// each at its points' median; the columns from the median azimuth step along each beam.
+/// Nullopt unless 90 % of those points lie on 8 to 256 such beams: a sensor with per-laser
+/// height offsets (an HDL-64E) smears its beams and is not measured this way.
+std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& cloud);
+
 /// The elevation of each row of an organized cloud (row 0 first), radians: the median over
 /// the row's points; nullopt for rows without any.
 std::vector<std::optional<double>> row_elevations(const PointCloud& cloud, int width, int height);
