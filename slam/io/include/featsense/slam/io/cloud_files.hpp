@@ -55,7 +55,8 @@ DecodedCloud decode_kitti_bin(std::string_view bytes, const std::string& origin)
 /// - a ring field: the smallest of vlp16 / hdl32 / hdl64 / os1-128 with beams > the largest
 ///   ring;
 /// - else the preset on whose beam elevations nearly all points lie (seen from its beam
-///   origin; exact for simulated or nominally calibrated data), else `unmatched_preset` where
+///   origin; exact for simulated or nominally calibrated data), else a model measured from
+///   the points where they lie on 8 to 256 clean beams, else `unmatched_preset` where
 ///   one is given (a KITTI .bin folder: hdl64, whose per-unit calibration fits no preset
 ///   exactly), else InputError asking for `--set sensor.preset=NAME`.
 config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptions& options,
