@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "common/test_data.hpp"
+#include "featsense/config/sensor_model.hpp"
 #include "featsense/slam/io/open_scan_source.hpp"
 #include "slam/pcap_test_util.hpp"
 #include "slam/ros2_test_writers.hpp"
@@ -121,6 +123,41 @@ TEST(Ros2Bag, AnUnknownSerializationIsNamedNotDecoded) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("json serialization"), std::string::npos) << e.what();
   }
+}
+
+// PointCloud2 clouds with neither rows nor a ring field are told by the elevations their
+// points lie on: a VLP-16's beams at 10 m, stored as one unorganized row.
+TEST(Ros2Bag, AnUnorganizedCloudWithoutRingsIsToldByItsBeams) {
+  const config::SensorModel vlp16 = config::sensor_preset("vlp16");
+  std::vector<TestMessage> messages;
+  for (int k = 0; k < 2; ++k) {
+    test::TestCloud cloud;
+    cloud.stamp_ns = spec_of(k).stamp_ns;
+    cloud.add_field("x", test::kFloat32);
+    cloud.add_field("y", test::kFloat32);
+    cloud.add_field("z", test::kFloat32);
+    cloud.allocate(1, static_cast<uint32_t>(vlp16.beams * 900));
+    size_t i = 0;
+    for (int c = 0; c < 900; ++c) {
+      const double azimuth = -2.0 * M_PI * c / 900;
+      for (const double elevation : vlp16.elevation_rad) {
+        const double range = 10.0 + 0.5 * std::sin(0.1 * c);
+        cloud.set(i, "x", range * std::cos(elevation) * std::cos(azimuth));
+        cloud.set(i, "y", range * std::cos(elevation) * std::sin(azimuth));
+        cloud.set(i, "z", range * std::sin(elevation));
+        ++i;
+      }
+    }
+    messages.push_back({kTopic, cloud.stamp_ns, test::cdr_pointcloud2(cloud)});
+  }
+  const auto dir = test::scratch_dir("ros2_unorganized_no_rings");
+  test::write_sqlite_bag(dir / "bag.db3", {{kTopic, kCloudType}}, messages);
+  std::unique_ptr<ScanSource> source = open_scan_source((dir / "bag.db3").string());
+  EXPECT_EQ(source->info().sensor.name, "vlp16") << source->info().detail;
+  const std::optional<Scan> scan = source->next();
+  ASSERT_TRUE(scan);
+  EXPECT_EQ(scan->rows, 16);
+  EXPECT_EQ(scan->valid_count(), static_cast<size_t>(16 * 900));
 }
 
 TEST(Ros2Bag, SplitBagIsReadFileByFile) {

@@ -191,17 +191,34 @@ TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {
     }
   }
 
-  // Without a ring field nothing tells the beams: the user must name the sensor.
+  // Without a ring field the elevations tell the beams (the reference scene's are a
+  // VLP-16's); sensor.preset still wins.
   test::TestCloud no_ring = cloud;
   no_ring.fields[4].name = "unused";
   TestBagWriter no_ring_writer(TestCompression::kNone);
   const uint32_t c = no_ring_writer.add_connection("/cloud", "sensor_msgs/PointCloud2");
   no_ring_writer.add_message(c, kFirstStamp, no_ring.serialize());
   const std::string no_ring_path = test::write_bag_file(dir, "n.bag", no_ring_writer.finish());
-  EXPECT_TRUE(contains(error_of(no_ring_path), "set sensor.preset")) << error_of(no_ring_path);
+  EXPECT_EQ(open_bag(no_ring_path, {})->info().sensor.name, "vlp16");
   SourceOptions options;
   options.sensor_preset = "hdl32";
   EXPECT_EQ(open_bag(no_ring_path, options)->info().sensor.name, "hdl32");
+
+  // Points on no beams at all (elevations spread evenly): the user must name the sensor.
+  test::TestCloud scattered = no_ring;
+  for (size_t i = 0; i < scattered.width; ++i) {
+    const double elevation =
+        (-15.0 + 30.0 * static_cast<double>(i) / scattered.width) * M_PI / 180.0;
+    const double azimuth = 2.0 * M_PI * static_cast<double>(i % 64) / 64.0;
+    scattered.set(i, "x", 8.0 * std::cos(elevation) * std::cos(azimuth));
+    scattered.set(i, "y", 8.0 * std::cos(elevation) * std::sin(azimuth));
+    scattered.set(i, "z", 8.0 * std::sin(elevation));
+  }
+  TestBagWriter scattered_writer(TestCompression::kNone);
+  const uint32_t d = scattered_writer.add_connection("/cloud", "sensor_msgs/PointCloud2");
+  scattered_writer.add_message(d, kFirstStamp, scattered.serialize());
+  const std::string scattered_path = test::write_bag_file(dir, "s.bag", scattered_writer.finish());
+  EXPECT_TRUE(contains(error_of(scattered_path), "set sensor.preset")) << error_of(scattered_path);
 }
 
 TEST(Rosbag, CloudsWithoutTimesGetThemFromTheAzimuth) {

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "cloud/sensor_guess.hpp"
 #include "featsense/slam/io/azimuth_times.hpp"
 #include "ros2/cdr_pointcloud2.hpp"
 #include "rosbag/cloud_sensor_model.hpp"
@@ -100,9 +101,21 @@ config::SensorModel choose_sensor(const BagTopicContext& context, const FirstClo
                      "set sensor.preset");
   }
   if (first.rings == 0) {
+    // Told by the elevations the points lie on, as clouds in files are (cloud_to_scan.cpp).
+    PointCloud points;
+    points.xyz = first.xyz;
+    if (const auto preset = cloud::preset_from_elevations(points)) {
+      how = "preset " + *preset + " (points lie on its beam elevations)";
+      return sensor_for(options, *preset);
+    }
+    if (const auto measured = cloud::sensor_from_elevations(points)) {
+      how = std::to_string(measured->beams) + " beams and " + std::to_string(measured->columns) +
+            " columns measured from the first cloud's points (no preset fits them)";
+      return *measured;
+    }
     throw InputError(context.origin + ": the clouds on " + context.topic.name +
-                     " are unorganized and have no ring field; set sensor.preset to the "
-                     "sensor that recorded them");
+                     " are unorganized, have no ring field and lie on no preset's beams; set "
+                     "sensor.preset to the sensor that recorded them");
   }
   if (const auto preset = preset_for_rings(first.rings, true)) {
     how = "preset " + *preset + " by its " + std::to_string(first.rings) + " rings";
