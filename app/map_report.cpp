@@ -20,6 +20,10 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
                      {"rows", input.sensor.beams},
                      {"cols", input.sensor.columns}};
   report["input"]["times"] = input.times;
+  // Which sensor model, and why: the recording's metadata, a preset the points fit, a model
+  // measured from them, or sensor.preset.
+  report["input"]["sensor_from_metadata"] = input.sensor_from_metadata;
+  report["input"]["detail"] = input.detail;
   report["frames"] = run.frames_mapped;
   report["frames_read"] = run.frames_read;
   report["frames_skipped"] = {{"without_pose", run.frames_without_pose},

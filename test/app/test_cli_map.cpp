@@ -65,6 +65,9 @@ TEST_F(CliMap, WritesTheMapThePosesAndTheReport) {
 
   const nlohmann::json report = read_json(out / "report.json");
   EXPECT_EQ(report["frames"], 24);
+  EXPECT_EQ(report["input"]["sensor"], "os1-128");
+  EXPECT_NE(report["input"]["detail"].get<std::string>().find("sensor"), std::string::npos)
+      << "the report says which sensor model and why";
   EXPECT_EQ(report["backend"], "cpu");
   EXPECT_FALSE(report["interrupted"].get<bool>());
   EXPECT_GT(report["scans_per_s"].get<double>(), 0.0);
