@@ -37,6 +37,10 @@ std::optional<slam::Scan> BenchScans::next() {
   return scan;
 }
 
+const config::SensorModel& BenchScans::sensor() const {
+  return recording_ ? recording_->info().sensor : simulator_->settings().sensor;
+}
+
 void BenchScans::check_read() const {
   if (count_ == 0) throw slam::InputError(name_ + ": no readable frame");
 }

@@ -67,7 +67,7 @@ nlohmann::json bench_odometry(const config::Config& config, BenchScans& scans,
   stages.integrate = false;
   if (options.refine) stages.refine = slam::refine::from_config(config);
   if (options.loops) stages.loops = slam::loops::from_config(config);
-  mapping::MapPass pass(*odometry, stages, config, config::SensorModel{}, {}, {});
+  mapping::MapPass pass(*odometry, stages, config, scans.sensor(), {}, {});
   slam::Trajectory estimate;  // the odometry's poses, before the refinement
   const auto map_final = [&pass](std::vector<mapping::PlacedScan> final) {
     for (mapping::PlacedScan& scan : final) {

@@ -30,6 +30,8 @@ class BenchScans {
   void check_read() const;
 
   const std::optional<slam::Trajectory>& truth() const { return truth_; }
+  /// The sensor that recorded the scans (the recording's, or the simulated one).
+  const config::SensorModel& sensor() const;
 
   /// The figures every front-end benchmark starts with: its name, the scans, their size.
   nlohmann::json json(const char* benchmark) const;
