@@ -9,16 +9,14 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/test_data.hpp"
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "featsense/slam/io/scan_writers.hpp"
-#include "featsense/slam/sim/lidar_simulator.hpp"
-#include "featsense/slam/sim/ray_caster.hpp"
-#include "featsense/slam/sim/scene_library.hpp"
-#include "featsense/slam/sim/trajectory.hpp"
+#include "featsense/slam/sim/prepared_simulation.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -33,18 +31,23 @@ struct Case {
 
 class SensorFromPoints : public ::testing::TestWithParam<Case> {};
 
+/// The first scan of a `preset` sensor along the built-in `scene`'s named `path`.
+Scan first_scan(const char* preset, const char* scene, const char* path,
+                const MeasurementSettings& measurement) {
+  SimulationRequest request;
+  request.scene = scene;
+  request.path = path;
+  request.sensor = preset;
+  request.measurement = measurement;
+  request.frames = 1;
+  const PreparedSimulation simulation(std::move(request));
+  return simulation.simulator->simulate(0).scan;
+}
+
 TEST_P(SensorFromPoints, AKittiBinFolderIsReadAsTheSensorThatMadeIt) {
   const Case c = GetParam();
-  const mesh::TriangleMesh mesh = build_scene(c.scene);
-  const RayCaster caster(mesh);
-  const NamedPath path = scene_path(c.scene, c.path);
-  const auto trajectory = make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);
-  SimulationSettings settings;
-  settings.sensor = config::sensor_preset(c.preset);
-  settings.measurement = MeasurementSettings::exact();
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
   const fs::path dir = test::scratch_dir(std::string("sensor_from_points_") + c.preset);
-  const Scan truth = simulator.simulate(0).scan;
+  const Scan truth = first_scan(c.preset, c.scene, c.path, MeasurementSettings::exact());
   write_scan_kitti_bin(truth, (dir / "000000.bin").string());
 
   const auto source = open_scan_folder(dir.string(), SourceOptions{});
@@ -71,15 +74,9 @@ TEST_P(SensorFromPoints, AKittiBinFolderIsReadAsTheSensorThatMadeIt) {
 // the upper half of every scan would be lost, so it is an error naming the share and the
 // preset that fits, never a map of half scans.
 TEST(SensorFromPoints, APresetThatDoesNotFitIsAnErrorNamingTheOneThatDoes) {
-  const mesh::TriangleMesh mesh = build_scene("lab");
-  const RayCaster caster(mesh);
-  const NamedPath path = scene_path("lab", "walk");
-  const auto trajectory = make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);
-  SimulationSettings settings;
-  settings.sensor = config::sensor_preset("os1-128");
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
   const fs::path dir = test::scratch_dir("sensor_from_points_wrong_preset");
-  write_scan_kitti_bin(simulator.simulate(0).scan, (dir / "000000.bin").string());
+  write_scan_kitti_bin(first_scan("os1-128", "lab", "walk", MeasurementSettings{}),
+                       (dir / "000000.bin").string());
   SourceOptions options;
   options.sensor_preset = "hdl64";
   try {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "beam_origin.hpp"
 #include "point_validity.hpp"
 
 namespace featsense::slam {
@@ -27,9 +28,7 @@ double half_spacing_at(const std::vector<double>& elevation_rad, size_t beam) {
 /// The beam nearest to a point's elevation, found by slope z / horizontal distance (which
 /// grows with the elevation, so no arctangent per point): the beam boundaries are the
 /// slopes of the elevations halfway between neighbouring beams. The horizontal distance is
-/// counted from the beam origin (`beam_origin_offset_m` out from the lidar origin along the
-/// azimuth, as Ouster sensors have it): from the lidar origin, a point 1 m away on an
-/// OS1-128's top beam seems 0.35 degrees (a whole beam spacing) lower than its beam.
+/// counted from the beam origin (beam_origin.hpp).
 class BeamLookup {
  public:
   /// `elevation_rad` from the highest beam to the lowest (SensorModel's order).
@@ -47,9 +46,8 @@ class BeamLookup {
   /// The row of the beam nearest to the point, or -1 when it lies more than half a beam
   /// spacing above the highest or below the lowest beam.
   int row_of(const Eigen::Vector3f& p) const {
-    const double x = static_cast<double>(p.x()), y = static_cast<double>(p.y());
-    double horizontal = std::sqrt(x * x + y * y);
-    if (horizontal > offset_m_) horizontal -= offset_m_;
+    const double horizontal = horizontal_from_beam_origin(static_cast<double>(p.x()),
+                                                          static_cast<double>(p.y()), offset_m_);
     const double s = static_cast<double>(p.z()) / horizontal;  // +-inf straight up / down
     if (!(s <= top_ && s >= bottom_)) return -1;
     // Boundaries descend; the number of them above the point is its row (a point exactly

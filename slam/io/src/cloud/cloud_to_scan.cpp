@@ -211,14 +211,9 @@ config::SensorModel choose_sensor(const DecodedCloud& decoded, const SourceOptio
                      ", more than any preset has beams; set --set sensor.preset=NAME (presets: " +
                      preset_list() + ")");
   }
-  if (const auto name = cloud::preset_from_elevations(cloud)) {
-    say("preset " + *name + " (points lie on its beam elevations)");
-    return sensor_for(options, *name);
-  }
-  if (const std::optional<config::SensorModel> measured = cloud::sensor_from_elevations(cloud)) {
-    say(std::to_string(measured->beams) + " beams and " + std::to_string(measured->columns) +
-        " columns measured from the points (no preset fits them)");
-    return *measured;
+  if (const std::optional<cloud::SensorFromPoints> found = cloud::sensor_from_points(cloud)) {
+    say(found->why);
+    return found->preset ? sensor_for(options, *found->preset) : *found->measured;
   }
   if (!unmatched_preset.empty()) {
     say("preset " + unmatched_preset +

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 
+#include "beam_origin.hpp"
 #include "point_validity.hpp"
 
 namespace featsense::slam::cloud {
@@ -22,13 +23,10 @@ constexpr size_t kMaxSampledPoints = 20000;
 constexpr double kMinFitFraction = 0.9;
 constexpr double kMinBeamsHitFraction = 0.5;
 
-/// The elevation of `p` seen from the beam origin, `beam_origin_offset_m` out from the lidar
-/// origin along the point's azimuth (organize.cpp says why).
+/// The elevation of `p` seen from the beam origin (beam_origin.hpp).
 double elevation_of(const Eigen::Vector3f& p, double beam_origin_offset_m = 0.0) {
   const Eigen::Vector3d q = p.cast<double>();
-  double horizontal = std::hypot(q.x(), q.y());
-  if (horizontal > beam_origin_offset_m) horizontal -= beam_origin_offset_m;
-  return std::atan2(q.z(), horizontal);
+  return std::atan2(q.z(), horizontal_from_beam_origin(q.x(), q.y(), beam_origin_offset_m));
 }
 
 double smallest_spacing(const std::vector<double>& elevation_rad) {
@@ -230,7 +228,7 @@ struct PolarPoint {
   double azimuth_rad;
 };
 
-/// Points at least kMinMeasuredRangeM away, every step-th, as elevation and azimuth.
+/// Every return at least kMinMeasuredRangeM away, as elevation and azimuth.
 std::vector<PolarPoint> polar_sample(const PointCloud& cloud) {
   std::vector<PolarPoint> points;
   for (const Eigen::Vector3f& p : cloud.xyz) {
@@ -259,6 +257,19 @@ std::optional<double> azimuth_step(std::vector<double> azimuth_rad) {
 }
 
 }  // namespace
+
+std::optional<SensorFromPoints> sensor_from_points(const PointCloud& cloud) {
+  if (std::optional<std::string> preset = preset_from_elevations(cloud))
+    return SensorFromPoints{preset, std::nullopt,
+                            "preset " + *preset + " (points lie on its beam elevations)"};
+  if (std::optional<config::SensorModel> measured = sensor_from_elevations(cloud)) {
+    std::string why = std::to_string(measured->beams) + " beams and " +
+                      std::to_string(measured->columns) +
+                      " columns measured from the points (no preset fits them)";
+    return SensorFromPoints{std::nullopt, std::move(measured), std::move(why)};
+  }
+  return std::nullopt;
+}
 
 std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& cloud) {
   std::vector<PolarPoint> points = polar_sample(cloud);

@@ -43,6 +43,16 @@ std::optional<std::string> preset_from_elevations(const PointCloud& cloud);
 /// height offsets (an HDL-64E) smears its beams and is not measured this way.
 std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& cloud);
 
+/// What the points of a cloud without rings say about its sensor.
+struct SensorFromPoints {
+  std::optional<std::string> preset;            ///< the one preset whose beams they lie on
+  std::optional<config::SensorModel> measured;  ///< else a model measured from them
+  std::string why;                              ///< which, and why, for info and the report
+};
+
+/// preset_from_elevations, else sensor_from_elevations; nullopt where neither tells.
+std::optional<SensorFromPoints> sensor_from_points(const PointCloud& cloud);
+
 /// The elevation of each row of an organized cloud (row 0 first), radians: the median over
 /// the row's points; nullopt for rows without any.
 std::vector<std::optional<double>> row_elevations(const PointCloud& cloud, int width, int height);

@@ -104,14 +104,9 @@ config::SensorModel choose_sensor(const BagTopicContext& context, const FirstClo
     // Told by the elevations the points lie on, as clouds in files are (cloud_to_scan.cpp).
     PointCloud points;
     points.xyz = first.xyz;
-    if (const auto preset = cloud::preset_from_elevations(points)) {
-      how = "preset " + *preset + " (points lie on its beam elevations)";
-      return sensor_for(options, *preset);
-    }
-    if (const auto measured = cloud::sensor_from_elevations(points)) {
-      how = std::to_string(measured->beams) + " beams and " + std::to_string(measured->columns) +
-            " columns measured from the first cloud's points (no preset fits them)";
-      return *measured;
+    if (const std::optional<cloud::SensorFromPoints> found = cloud::sensor_from_points(points)) {
+      how = found->why;
+      return found->preset ? sensor_for(options, *found->preset) : *found->measured;
     }
     throw InputError(context.origin + ": the clouds on " + context.topic.name +
                      " are unorganized, have no ring field and lie on no preset's beams; set "
