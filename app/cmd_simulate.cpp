@@ -49,6 +49,10 @@ slam::SimulationRequest simulation_request(const SimulateOptions& o) {
   request.measurement.dropouts = !o.no_dropouts;
   request.measurement.mixed_pixels = !o.no_mixed_pixels;
   request.frames = o.frames;
+  if (o.stop.size() == 2) {
+    request.stop_at_s = o.stop[0];
+    request.stop_for_s = o.stop[1];
+  }
   return request;
 }
 
@@ -113,6 +117,13 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
                       "TUM file of sensor poses (map <- sensor)");
   command->add_option("--frames", o->frames, "Frames to simulate (default: the whole path)")
       ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--stop", o->stop,
+                   "AT,FOR: the sensor brakes to a stand where the path is at AT seconds, "
+                   "stands FOR seconds and goes on (a stop at a crossing, a pause)")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--rate", o->rate_hz, "Revolutions per second (default: the sensor's)")
       ->check(CLI::Range(0.1, 100.0));
   command->add_option("--seed", o->seed, "Seed of the measurement noise")->capture_default_str();

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cli_context.hpp"
 #include "featsense/slam/sim/prepared_simulation.hpp"
@@ -17,6 +18,8 @@ struct SimulateOptions {
   std::string trajectory_file;
   int frames = 0;  ///< 0: as many as the trajectory holds
   double rate_hz = 0.0;
+  /// --stop AT,FOR: stand FOR seconds where the path is at AT seconds; empty: no stop.
+  std::vector<double> stop;
   uint64_t seed = 1;
   double unit_scale = 1.0;
   std::string up_axis = "auto";

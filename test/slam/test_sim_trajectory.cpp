@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -89,6 +90,38 @@ TEST(SimTrajectory, YawFollowsTheDirectionOfTravelAndTiltLeansIntoTurns) {
   const Eigen::Matrix3d r = tilted->pose(tw).rotation();
   const Eigen::Vector3d left = r.col(1);
   EXPECT_GT(r.col(2).dot(left - left.z() * Eigen::Vector3d::UnitZ()), 0.0);
+}
+
+TEST(SimTrajectory, APausedPathBrakesStandsAndGoesOn) {
+  // Stand 3 s where the path is at 4 s, braking over 2 s: the path's own time is warped.
+  const auto path = make_spline_trajectory(kWaypoints, kSpeed);
+  const double duration_s = path->duration_s();
+  const auto paused =
+      make_paused_trajectory(make_spline_trajectory(kWaypoints, kSpeed), 5.0, 3.0, 2.0);
+  EXPECT_NEAR(paused->duration_s(), duration_s + 5.0, 1e-12);
+  // Before braking and after starting again: the path itself, shifted by the stand and a ramp.
+  EXPECT_TRUE(paused->pose(2.5).isApprox(path->pose(2.5), 1e-12));
+  EXPECT_TRUE(paused->pose(12.0).isApprox(path->pose(7.0), 1e-12));
+  // Standing where the path is at 4 s, for the whole stand.
+  for (double t = 5.0; t <= 8.0; t += 0.5) {
+    EXPECT_TRUE(paused->pose(t).isApprox(path->pose(4.0), 1e-12)) << t;
+  }
+  // The speed falls and rises smoothly: no jump between samples 10 ms apart, and the braking
+  // peaks at pi / 2 times the mean deceleration (1.5 m/s over 2 s: 1.18 m/s^2).
+  const double h = 0.01;
+  double last_speed = kSpeed;
+  double largest_change = 0.0;
+  for (double t = 2.0; t < 11.0; t += h) {
+    const double speed = (position(*paused, t + h) - position(*paused, t)).norm() / h;
+    largest_change = std::max(largest_change, std::abs(speed - last_speed) / h);
+    last_speed = speed;
+  }
+  EXPECT_LT(largest_change, 1.3);
+  EXPECT_GT(largest_change, 1.0);
+  EXPECT_THROW(make_paused_trajectory(make_spline_trajectory(kWaypoints, kSpeed), 1.0, 3.0, 2.0),
+               std::invalid_argument);  // braking would start before the path
+  EXPECT_THROW(make_paused_trajectory(make_spline_trajectory(kWaypoints, kSpeed), 5.0, 0.0, 2.0),
+               std::invalid_argument);
 }
 
 TEST(SimTrajectory, BadSplinesAreRefused) {

@@ -1,5 +1,6 @@
 #include "featsense/slam/sim/prepared_simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -48,6 +49,27 @@ std::unique_ptr<PoseCurve> make_trajectory(const SimulationRequest& request, boo
   return make_spline_trajectory(path.waypoints_m, path.speed_mps, path.tilt);
 }
 
+/// The gentlest braking a stop uses, m/s^2: a car braking for a crossing, a walker pausing.
+constexpr double kStopDeceleration = 1.5;
+
+/// `path` with the request's stop, if any: the ramp lasts as long as braking from the speed
+/// the path has there takes (a half-cosine profile peaks at pi/2 times the mean deceleration),
+/// at least a second.
+std::unique_ptr<PoseCurve> with_stop(std::unique_ptr<PoseCurve> path,
+                                     const SimulationRequest& request) {
+  if (request.stop_for_s <= 0.0 && request.stop_at_s <= 0.0) return path;
+  constexpr double kPi = 3.14159265358979323846;
+  const double at_s = request.stop_at_s;
+  const double before_s = std::max(at_s - 0.2, 0.0);
+  const double speed_mps =
+      at_s > before_s
+          ? (path->pose(at_s).translation() - path->pose(before_s).translation()).norm() /
+                (at_s - before_s)
+          : 0.0;
+  const double ramp_s = std::max(1.0, kPi * speed_mps / (2.0 * kStopDeceleration));
+  return make_paused_trajectory(std::move(path), at_s + 0.5 * ramp_s, request.stop_for_s, ramp_s);
+}
+
 }  // namespace
 
 PreparedSimulation::PreparedSimulation(SimulationRequest request) {
@@ -62,7 +84,7 @@ PreparedSimulation::PreparedSimulation(SimulationRequest request) {
   }
   mesh = builtin ? build_scene(request.scene) : std::move(*request.scene_mesh);
   SimulationSettings settings;
-  trajectory = make_trajectory(request, builtin, &settings.start_stamp_ns);
+  trajectory = with_stop(make_trajectory(request, builtin, &settings.start_stamp_ns), request);
   settings.sensor = sensor_model(request.sensor);
   if (request.rate_hz > 0.0) settings.sensor.rate_hz = request.rate_hz;
   settings.measurement = request.measurement;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "featsense/slam/io/scan_writers.hpp"
 #include "featsense/slam/scan_source.hpp"
@@ -189,7 +190,58 @@ class SampledPoseCurve final : public PoseCurve {
   std::vector<StampedPose> poses_;
 };
 
+/// A path followed in warped time: its own time advances at a speed factor that falls from 1
+/// to 0 over the ramp before the stand, stays 0 for the stand and rises back over the ramp.
+class PausedPoseCurve final : public PoseCurve {
+ public:
+  PausedPoseCurve(std::unique_ptr<PoseCurve> path, double at_s, double for_s, double ramp_s)
+      : path_(std::move(path)), at_s_(at_s), for_s_(for_s), ramp_s_(ramp_s) {}
+
+  double duration_s() const override { return path_->duration_s() + for_s_ + ramp_s_; }
+
+  Eigen::Isometry3d pose(double t_s) const override { return path_->pose(path_time(t_s)); }
+
+  /// The path's own time at `t_s`: the integral of the speed factor.
+  double path_time(double t_s) const {
+    constexpr double kPi = 3.14159265358979323846;
+    const double slow_from = at_s_ - ramp_s_;
+    const double resume_at = at_s_ + for_s_;
+    const double stood_at = at_s_ - 0.5 * ramp_s_;  // the path's time where it stands
+    const double k = ramp_s_ / kPi;
+    if (t_s <= slow_from) return t_s;
+    if (t_s < at_s_) {
+      const double u = t_s - slow_from;  // factor 0.5 (1 + cos(pi u / ramp))
+      return slow_from + 0.5 * u + 0.5 * k * std::sin(u / k);
+    }
+    if (t_s <= resume_at) return stood_at;
+    if (t_s < resume_at + ramp_s_) {
+      const double u = t_s - resume_at;  // factor 0.5 (1 - cos(pi u / ramp))
+      return stood_at + 0.5 * u - 0.5 * k * std::sin(u / k);
+    }
+    return t_s - for_s_ - ramp_s_;
+  }
+
+ private:
+  std::unique_ptr<PoseCurve> path_;
+  double at_s_;
+  double for_s_;
+  double ramp_s_;
+};
+
 }  // namespace
+
+std::unique_ptr<PoseCurve> make_paused_trajectory(std::unique_ptr<PoseCurve> path, double at_s,
+                                                  double for_s, double ramp_s) {
+  if (path == nullptr) throw std::invalid_argument("a stop needs a path");
+  if (!(ramp_s > 0.0) || !(for_s > 0.0))
+    throw std::invalid_argument("a stop needs a time to stand and to slow down, both > 0 s");
+  if (!(at_s >= ramp_s) || !(at_s - 0.5 * ramp_s < path->duration_s()))
+    throw std::invalid_argument("a stop at " + std::to_string(at_s) +
+                                " s lies outside the path (it slows down from " +
+                                std::to_string(ramp_s) + " s before; the path lasts " +
+                                std::to_string(path->duration_s()) + " s)");
+  return std::make_unique<PausedPoseCurve>(std::move(path), at_s, for_s, ramp_s);
+}
 
 std::unique_ptr<PoseCurve> make_spline_trajectory(const std::vector<Eigen::Vector3d>& waypoints_m,
                                                   double speed_mps, bool tilt) {

@@ -29,6 +29,10 @@ struct SimulationRequest {
   double rate_hz = 0.0;             ///< revolutions per second; 0: the sensor's
   MeasurementSettings measurement;  ///< noise, intensity, drop-outs, mixed pixels
   int frames = 0;                   ///< 0: as many as the path holds
+  /// A stop on the path (make_paused_trajectory): the sensor stands `stop_for_s` seconds
+  /// where the path is at `stop_at_s`, braking and starting at 1.5 m/s^2 at most. 0: none.
+  double stop_at_s = 0.0;
+  double stop_for_s = 0.0;
 };
 
 struct PreparedSimulation {

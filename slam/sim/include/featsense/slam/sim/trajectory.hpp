@@ -42,6 +42,15 @@ std::unique_ptr<PoseCurve> make_spline_trajectory(const std::vector<Eigen::Vecto
 /// samples or times that do not increase.
 std::unique_ptr<PoseCurve> make_sampled_trajectory(const std::vector<StampedPose>& poses);
 
+/// `path` with a stop: from `at_s` seconds on the sensor slows to a stand over `ramp_s`
+/// (speed falling as a half cosine, so acceleration stays finite: a car's braking, a walker's
+/// pause), stands for `for_s` and speeds up again over `ramp_s` to continue the path where it
+/// stopped. The path is followed as before, only in time warped; it lasts for_s + ramp_s
+/// longer. Throws std::invalid_argument for a stop outside the path (at_s < ramp_s or past
+/// its end), for_s <= 0 or ramp_s <= 0.
+std::unique_ptr<PoseCurve> make_paused_trajectory(std::unique_ptr<PoseCurve> path, double at_s,
+                                                  double for_s, double ramp_s);
+
 /// The poses of a trajectory file (trajectory_io.hpp reads and writes TUM and KITTI), and back.
 std::vector<StampedPose> to_stamped_poses(const Trajectory& trajectory);
 Trajectory to_trajectory(const std::vector<StampedPose>& poses);
