@@ -248,6 +248,7 @@ std::vector<KeySpec> make_specs() {
                   &OdometryConfig::optimization_steps, 1, 20),
       bool_key("odometry.intensity_fusion", &Config::odometry, &OdometryConfig::intensity_fusion),
       bool_key("odometry.deskew", &Config::odometry, &OdometryConfig::deskew),
+      bool_key("odometry.hold_still", &Config::odometry, &OdometryConfig::hold_still),
       number_key("odometry.edge_voxel", &Config::odometry, &OdometryConfig::edge_voxel_m,
                  {0.0, 10.0, true}),
       number_key("odometry.surface_voxel", &Config::odometry, &OdometryConfig::surface_voxel_m,

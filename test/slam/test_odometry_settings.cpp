@@ -20,6 +20,7 @@ void expect_same(const OdometrySettings& a, const OdometrySettings& b) {
   EXPECT_EQ(a.max_speed_m_s, b.max_speed_m_s);
   EXPECT_EQ(a.max_turn_rate_rad_s, b.max_turn_rate_rad_s);
   EXPECT_EQ(a.deskew, b.deskew);
+  EXPECT_EQ(a.hold_still, b.hold_still);
 }
 
 TEST(OdometrySettings, TheDefaultConfigurationGivesTheDefaults) {
@@ -39,6 +40,7 @@ TEST(OdometrySettings, EveryKeyReachesItsSetting) {
   c.max_speed_m_s = 20.0;
   c.max_turn_rate_rad_s = 2.0;
   c.deskew = false;
+  c.hold_still = false;
 
   OdometrySettings expected;
   expected.optimization_steps = 5;
@@ -51,6 +53,7 @@ TEST(OdometrySettings, EveryKeyReachesItsSetting) {
   expected.max_speed_m_s = 20.0;
   expected.max_turn_rate_rad_s = 2.0;
   expected.deskew = false;
+  expected.hold_still = false;
   expect_same(from_config(config), expected);
 }
 

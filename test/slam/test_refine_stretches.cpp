@@ -138,6 +138,30 @@ TEST(SegmentRefiner, AStandingSensorEndsAStretchByCount) {
   for (const Eigen::Isometry3d& p : final) EXPECT_TRUE(p.isApprox(Eigen::Isometry3d::Identity()));
 }
 
+TEST(SegmentRefiner, AStretchTheSensorStoodThroughIsNotMoved) {
+  // The odometry held the pose (standing still): a registration of the stand against the
+  // stretch before would move it by its noise, a drift of its own.
+  const mesh::TriangleMesh lab = build_scene("lab");
+  RefineSettings settings = every_two_metres();
+  settings.max_scans = 6;
+  SegmentRefiner refiner(settings);
+  const Eigen::Isometry3d stand = pose(0.3, 0.0, 0.0, {-7.0, -7.5, 1.5});
+  ASSERT_TRUE(refiner.add(stand, lab_cloud(lab, stand, 1)));
+  ASSERT_EQ(refiner.refine().size(), 1u);
+  for (uint32_t round = 0; round < 3; ++round) {
+    for (uint32_t i = 0; i < 6; ++i) {
+      GaussianCloud cloud;
+      if (refiner.needs_cloud(stand)) cloud = lab_cloud(lab, stand, 10 * round + i + 2);
+      if (!refiner.add(stand, std::move(cloud))) continue;
+      for (const Eigen::Isometry3d& p : refiner.refine()) {
+        EXPECT_TRUE(p.isApprox(stand, 1e-12)) << "round " << round;
+      }
+    }
+  }
+  EXPECT_EQ(refiner.counts().stood, 3u);
+  EXPECT_EQ(refiner.counts().refined, 0u);
+}
+
 /// The box room's scans placed with their true poses (the map frame at the first), deskewed
 /// with the true motion except the first, placed before any motion is known.
 TEST(PlacementRefiner, FinalPlacementsComeInOrderAndTheFirstIsDeskewed) {

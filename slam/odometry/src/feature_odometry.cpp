@@ -6,6 +6,7 @@
 #include <string>
 
 #include "featsense/slam/odometry/local_feature_map.hpp"
+#include "featsense/slam/odometry/stand_detector.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "scan_to_map.hpp"
 #include "timed_features.hpp"
@@ -19,6 +20,9 @@ namespace {
 constexpr int kMaxRestartRounds = 12;
 /// The restart's rounds converge slowly: it stops on a finer change than a registration.
 constexpr double kRestartSettledM = 2e-5;
+/// A deskewed registration whose motion lies within this many times the stand's bound
+/// (squared: 5 times the noise) is tried rigidly from the last pose for a stand.
+constexpr double kStillSearch = 25.0;
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -28,7 +32,9 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 FeatureOdometry::FeatureOdometry(const OdometrySettings& settings)
-    : settings_(settings), map_(new_map()) {}
+    : settings_(settings),
+      map_(new_map()),
+      stand_(settings.stand_enter_scans, settings.stand_leave_scans) {}
 
 FeatureOdometry::~FeatureOdometry() = default;
 
@@ -57,9 +63,12 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
           last_pose_ * motion_fraction(last_motion_, result.elapsed_s / last_motion_s_);
     }
     if (!start.prediction.matrix().allFinite()) start.prediction = last_pose_;
+    // Standing: the pose is held and the sweep rigid, until the registration says otherwise.
+    if (stand_.standing()) start.deskew = false;
   }
 
   Eigen::Isometry3d pose = start.prediction;
+  bool registered = false;
   if (raw.empty()) {
     result.diagnostics.converged = false;
     result.reason = "no features";
@@ -67,16 +76,83 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
     result.reason = "first scan: the map starts here";
   } else {
     pose = register_to_map(*map_, raw, start, settings_, result);
-    if (first_scan_ && result.diagnostics.converged && start.elapsed_s > 0.0) {
-      pose = restart_map(raw, start, pose, imu, result);
-    }
+    registered = true;
+  }
+
+  // Standing still: judged before the first map restarts (a sensor that stands needs no
+  // deskewed first scan).
+  StandDetector::Verdict verdict;
+  verdict.pose = pose;
+  if (registered && settings_.hold_still && result.elapsed_s > 0.0) {
+    const StillTest still = still_test(raw, start, pose, result);
+    verdict =
+        stand_.update(last_pose_, last_precision_, still.pose, still.precision, still.converged);
+    if (!verdict.standing) verdict.pose = pose;
+  }
+  if (!verdict.standing && first_scan_ && result.diagnostics.converged && start.elapsed_s > 0.0) {
+    pose = restart_map(raw, start, pose, imu, result);
   }
   first_scan_.reset();
   if (!started_ && !raw.empty()) first_scan_ = std::make_unique<TimedFeatures>(raw);
   if (!started_ || result.elapsed_s > 0.0) last_imu_ = imu;
+  if (verdict.standing) {
+    hold(verdict.pose, features.stamp_ns, result);
+    return result;
+  }
+  if (verdict.resumed) {
+    // The stand ended within the last leave_scans scans: the motion since the anchor is
+    // spread over them, and the previous pose taken one such share back, for the prediction
+    // and the deskewing.
+    const Eigen::Isometry3d motion = motion_fraction(
+        last_pose_.inverse() * pose, 1.0 / static_cast<double>(settings_.stand_leave_scans));
+    last_pose_ = pose * motion.inverse();
+  }
+  last_precision_ = result.precision;
   add_to_map(raw, SweepMotion(last_pose_.inverse() * pose, result.elapsed_s, start.twist), pose,
              features.stamp_ns, result);
   return result;
+}
+
+FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
+                                                       const RegistrationStart& start,
+                                                       const Eigen::Isometry3d& pose,
+                                                       const OdometryResult& result) const {
+  StillTest test{pose, result.precision, result.diagnostics.converged};
+  // Deskewing estimates the motion within the sweep from the scan itself: where the motion
+  // is within a few times the noise it is mostly the noise, and the deskewed registration
+  // scatters by more than its covariance says. Whether the sensor stands is asked of a rigid
+  // registration from the last pose instead: the hypothesis under test, measured as it is.
+  if (!start.deskew || !settings_.deskew || stand_.standing()) return test;
+  int dimensions = 0;
+  const double distance2 =
+      mahalanobis_step(last_pose_, last_precision_, pose, result.precision, &dimensions);
+  if (dimensions == 0 || distance2 > kStillSearch * chi_squared_999(dimensions)) return test;
+  RegistrationStart rigid = start;
+  rigid.prediction = last_pose_;
+  rigid.deskew = false;
+  OdometryResult rigid_result;
+  const Eigen::Isometry3d rigid_pose = register_to_map(*map_, raw, rigid, settings_, rigid_result);
+  if (rigid_result.diagnostics.converged) {
+    test = StillTest{rigid_pose, rigid_result.precision, true};
+  }
+  return test;
+}
+
+void FeatureOdometry::hold(const Eigen::Isometry3d& pose, int64_t stamp_ns,
+                           OdometryResult& result) {
+  // Standing: the stand's pose, no motion to predict or deskew with, and the local map as it
+  // was (a scan added at a scattered pose would move the map with it).
+  result.standing = true;
+  result.T_map_sensor = pose;
+  result.T_previous_sensor = last_pose_.inverse() * pose;
+  result.sweep = SweepMotion();
+  result.reason = "standing still: the pose is held";
+  last_pose_ = pose;
+  last_motion_ = Eigen::Isometry3d::Identity();
+  last_motion_s_ = result.elapsed_s;
+  last_stamp_ns_ = stamp_ns;
+  result.map_edges = map_->edge_count();
+  result.map_surfaces = map_->surface_count();
 }
 
 Eigen::Isometry3d FeatureOdometry::restart_map(const TimedFeatures& raw,

@@ -63,6 +63,14 @@ class FeatureOdometryLocator final : public OdometryLocator {
             "): the pose is the prediction";
     }
     if (!jump.empty()) why = why.empty() ? jump : why + "; " + jump;
+    if (result.standing) {
+      if (!last_standing_) ++counts_.stands;
+      ++counts_.standing_scans;
+      counts_.standing_s += result.elapsed_s;
+    }
+    last_standing_ = result.standing;
+    // A standing scan is placed as measured: the sensor did not move within it.
+    if (result.standing) last_sweep_ = SweepMotion();
     if (result.sweep.moving()) last_sweep_ = result.sweep;
     const bool moving = last_sweep_.moving();
 
@@ -122,6 +130,7 @@ class FeatureOdometryLocator final : public OdometryLocator {
   /// is deskewed with it).
   SweepMotion last_sweep_;
   double period_s_ = 0.0;  ///< the shortest time between two scans so far
+  bool last_standing_ = false;
   OdometryCounts counts_;
 };
 

@@ -15,6 +15,7 @@ OdometrySettings from_config(const config::Config& config) {
   s.max_speed_m_s = c.max_speed_m_s;
   s.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
   s.deskew = c.deskew;
+  s.hold_still = c.hold_still;
   return s;
 }
 

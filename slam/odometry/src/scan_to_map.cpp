@@ -16,6 +16,7 @@
 #include "featsense/slam/odometry/feature_fit.hpp"
 #include "featsense/slam/odometry/huber_folding.hpp"
 #include "featsense/slam/odometry/point_residuals.hpp"
+#include "featsense/slam/odometry/pose_tangent.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
@@ -208,42 +209,47 @@ Cost cost_at(const Correspondences& c, const Eigen::Isometry3d& T, double huber)
   return cost;
 }
 
-/// J^T J / N over the residual rows, in the tangent [rotation, translation].
-Matrix6d information_at(const Correspondences& c, const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.rotation());
-  Matrix6d h = Matrix6d::Zero();
+/// J^T J over the residual rows, in the tangent [rotation, translation], and the rows'
+/// mean square, each clipped at the Huber scale `huber`.
+struct Information {
+  Matrix6d jtj = Matrix6d::Zero();
   size_t rows = 0;
+  double mean_square_m2 = 0.0;
+
+  /// J^T J / N: what degeneracy is judged on.
+  Matrix6d per_row() const {
+    return rows > 0 ? Matrix6d(jtj / static_cast<double>(rows)) : Matrix6d::Zero();
+  }
+  /// The inverse covariance: J^T J / s^2.
+  Matrix6d precision() const {
+    return mean_square_m2 > 0.0 ? Matrix6d(jtj / mean_square_m2) : Matrix6d::Zero();
+  }
+};
+
+Information information_at(const Correspondences& c, const Eigen::Isometry3d& T, double huber) {
+  const Eigen::Quaterniond q(T.rotation());
+  const Eigen::Vector3d t = T.translation();
+  const double huber2 = huber * huber;
+  Information info;
+  double squares = 0.0;
   for (const PointToLine& l : c.lines) {
     const Eigen::Matrix<double, 3, 6> j = l.tangent_jacobian(q);
-    h += j.transpose() * j;
-    rows += 2;  // the residual lies in the plane normal to the line: two rows' worth
+    info.jtj += j.transpose() * j;
+    info.rows += 2;  // the residual lies in the plane normal to the line: two rows' worth
+    Eigen::Vector3d r;
+    l.evaluate(q.coeffs().data(), t.data(), r.data(), nullptr, nullptr);
+    squares += std::min(r.squaredNorm(), 2.0 * huber2);
   }
   for (const PointToPlane& p : c.planes) {
     const Eigen::Matrix<double, 1, 6> j = p.tangent_jacobian(q);
-    h += j.transpose() * j;
-    rows += 1;
+    info.jtj += j.transpose() * j;
+    info.rows += 1;
+    double r = 0.0;
+    p.evaluate(q.coeffs().data(), t.data(), &r, nullptr, nullptr);
+    squares += std::min(r * r, huber2);
   }
-  return rows > 0 ? Matrix6d(h / static_cast<double>(rows)) : Matrix6d::Zero();
-}
-
-/// The tangent step [w, dt] from `from` to `to`: to = (Exp(w) R_from, t_from + dt).
-Vector6d tangent_between(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to) {
-  const Eigen::AngleAxisd turn(Eigen::Matrix3d(to.rotation() * from.rotation().transpose()));
-  Vector6d d;
-  d.head<3>() = turn.angle() * turn.axis();
-  d.tail<3>() = to.translation() - from.translation();
-  return d;
-}
-
-Eigen::Isometry3d apply_tangent(const Eigen::Isometry3d& from, const Vector6d& d) {
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  const double angle = d.head<3>().norm();
-  const Eigen::Matrix3d turn =
-      angle > 0.0 ? Eigen::AngleAxisd(angle, d.head<3>() / angle).toRotationMatrix()
-                  : Eigen::Matrix3d::Identity();
-  out.linear() = turn * from.rotation();
-  out.translation() = from.translation() + d.tail<3>();
-  return out;
+  if (info.rows > 0) info.mean_square_m2 = squares / static_cast<double>(info.rows);
+  return info;
 }
 
 bool finite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
@@ -299,7 +305,7 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
                                   const RegistrationStart& start, const OdometrySettings& settings,
                                   OdometryResult& result) {
   const Eigen::Isometry3d& prediction = start.prediction;
-  const bool deskew = settings.deskew && start.elapsed_s > 0.0;
+  const bool deskew = settings.deskew && start.deskew && start.elapsed_s > 0.0;
   const auto fail = [&](std::string why) {
     result.diagnostics.converged = false;
     result.reason = std::move(why);
@@ -336,8 +342,9 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
   result.surface_correspondences = c.planes.size();
 
   // Degeneracy: keep the prediction along the unobservable directions.
+  const Information information = information_at(c, pose, settings.huber_loss_m);
   const Degeneracy degeneracy =
-      analyse_degeneracy(information_at(c, pose), settings.degeneracy_threshold);
+      analyse_degeneracy(information.per_row(), settings.degeneracy_threshold);
   result.information_eigenvalues = degeneracy.eigenvalues;
   result.diagnostics.degenerate = degeneracy.degenerate();
   result.degenerate_directions = degeneracy.unobservable;
@@ -362,6 +369,7 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
   }
   result.diagnostics.fitness_m = at_pose.mean_distance;
   result.diagnostics.converged = true;
+  result.precision = information.precision();
   return pose;
 }
 

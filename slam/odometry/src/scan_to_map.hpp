@@ -19,6 +19,9 @@ struct RegistrationStart {
   Eigen::Isometry3d previous;    ///< the previous scan's pose (map <- sensor)
   double elapsed_s = 0.0;        ///< since the previous scan; 0: no motion to deskew with
   GyroTwist twist;               ///< the gyroscope's bend of the sweep, where measured
+  /// false: the features are registered rigidly, as measured (a sensor standing still: the
+  /// motion within the sweep is the question, not a given).
+  bool deskew = true;
 };
 
 /// Whether a pose moved less than `move_m` and turned less than what moves a point 10 m away

@@ -21,6 +21,8 @@ const char* to_string(RefineOutcome outcome) {
       return "moved too far";
     case RefineOutcome::worse_fit:
       return "fits worse";
+    case RefineOutcome::stood:
+      return "stood still";
   }
   return "?";
 }
@@ -107,6 +109,7 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::refine() {
   std::vector<HeldScan> stretch = std::move(held_);
   held_.clear();
   last_cloud_m_ = 0.0;
+  const bool anchored_before = anchored_;
   if (!anchored_) {
     // The first scan's pose is the odometry's: it defines the map frame.
     anchored_ = true;
@@ -121,10 +124,23 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::refine() {
   registration.scans = stretch.size();
   const bool clouds = std::any_of(stretch.begin(), stretch.end(),
                                   [](const HeldScan& scan) { return scan.cloud.size() > 0; });
-  poses = clouds && target_.size() > 0 ? register_stretch(stretch, guesses, registration) : guesses;
+  // A stretch the odometry held at the last final scan's pose throughout (the sensor stood
+  // still) has not drifted: registering it again would only move a standing sensor by the
+  // registration's noise.
+  const bool stood =
+      anchored_before && std::all_of(stretch.begin(), stretch.end(), [&](const HeldScan& scan) {
+        return scan.T_odometry_sensor.matrix() == anchor_odometry_.matrix();
+      });
+  if (stood) {
+    registration.outcome = RefineOutcome::stood;
+    guesses.assign(stretch.size(), anchor_final_);  // exactly, not through a round trip
+  }
+  poses = clouds && target_.size() > 0 && !stood ? register_stretch(stretch, guesses, registration)
+                                                 : guesses;
   anchor_odometry_ = stretch.back().T_odometry_sensor;
   anchor_final_ = poses.back();
-  keep_as_target(stretch, poses);
+  // A stood stretch saw nothing the target lacks: the stretches along the path stay it.
+  if (!stood) keep_as_target(stretch, poses);
 
   counts_.scans += stretch.size();
   switch (registration.outcome) {
@@ -141,6 +157,9 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::refine() {
       break;
     case RefineOutcome::worse_fit:
       ++counts_.worse_fit;
+      break;
+    case RefineOutcome::stood:
+      ++counts_.stood;
       break;
   }
   registration.ms =

@@ -86,6 +86,7 @@ struct OdometryConfig {
   int optimization_steps = 3;
   bool intensity_fusion = true;
   bool deskew = true;
+  bool hold_still = true;  ///< hold the pose while the sensor stands (see default.yaml)
   // Registration (slam/odometry). Why each value: default.yaml.
   double edge_voxel_m = 0.2;     ///< voxel of the local edge map and of each scan's edges
   double surface_voxel_m = 0.4;  ///< voxel of the local surface map and of the scan's surfaces

@@ -12,6 +12,7 @@
 #include "featsense/slam/imu_sample.hpp"
 #include "featsense/slam/odometry/odometry_result.hpp"
 #include "featsense/slam/odometry/odometry_settings.hpp"
+#include "featsense/slam/odometry/stand_detector.hpp"
 #include "featsense/slam/trajectory/sweep_motion.hpp"
 
 namespace featsense::slam::odometry {
@@ -34,6 +35,8 @@ class FeatureOdometry {
   /// In degenerate directions the pose keeps the prediction. Every scan with features is
   /// then added to the map at the pose given. The second scan restarts the map with the
   /// first one deskewed, once the motion is known, and is registered again.
+  /// With hold_still, a sensor that stands still (StandDetector) keeps the stand's pose and
+  /// adds nothing to the map until its registration leaves the noise about that pose.
   /// `imu`: the IMU's samples of this sweep (Scan::imu), where the source has them: with
   /// the last sweep's they bend the deskewing motion by the measured turn (SweepMotion).
   OdometryResult register_scan(const FeatureSet& features, const std::vector<ImuSample>& imu = {});
@@ -43,6 +46,15 @@ class FeatureOdometry {
   Eigen::Isometry3d restart_map(const TimedFeatures& raw, const RegistrationStart& start,
                                 const Eigen::Isometry3d& pose, const std::vector<ImuSample>& imu,
                                 OdometryResult& result);
+  /// The pose and precision a stand is judged by (see still_test in the source).
+  struct StillTest {
+    Eigen::Isometry3d pose;
+    Eigen::Matrix<double, 6, 6> precision;
+    bool converged;
+  };
+  StillTest still_test(const TimedFeatures& raw, const RegistrationStart& start,
+                       const Eigen::Isometry3d& pose, const OdometryResult& result) const;
+  void hold(const Eigen::Isometry3d& pose, int64_t stamp_ns, OdometryResult& result);
   void add_to_map(const TimedFeatures& raw, const SweepMotion& sweep, const Eigen::Isometry3d& pose,
                   int64_t stamp_ns, OdometryResult& result);
 
@@ -58,6 +70,9 @@ class FeatureOdometry {
   double last_motion_s_ = 0.0;
   /// The last sweep's IMU samples: the gyroscope's mean rate over the period before a stamp.
   std::vector<ImuSample> last_imu_;
+  /// The last pose's precision (OdometryResult::precision), for the stand detector.
+  Eigen::Matrix<double, 6, 6> last_precision_ = Eigen::Matrix<double, 6, 6>::Zero();
+  StandDetector stand_;
 };
 
 }  // namespace featsense::slam::odometry

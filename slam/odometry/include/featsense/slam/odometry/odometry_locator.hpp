@@ -20,6 +20,9 @@ struct OdometryCounts {
   size_t degenerate_scans = 0;  ///< a direction of motion held at the prediction
   size_t failed_scans = 0;      ///< the pose is the prediction (the reason is logged)
   size_t time_jumps = 0;        ///< frames dropped, or a stamp that did not grow
+  size_t stands = 0;            ///< times the sensor stood still (odometry.hold_still)
+  size_t standing_scans = 0;    ///< scans whose pose was held while it stood
+  double standing_s = 0.0;      ///< the time between them and the scan before each
   size_t intensity_confirmed_scans = 0;
   double features_sum = 0.0;            ///< edge + surface points, summed over scans
   std::vector<double> features_ms;      ///< per scan: the feature extraction

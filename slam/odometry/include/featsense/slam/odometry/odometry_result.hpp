@@ -37,6 +37,13 @@ struct OdometryResult {
   std::vector<Eigen::Matrix<double, 6, 1>> degenerate_directions;
   /// The eigenvalues of J^T J / N at the result, ascending (see degeneracy_threshold).
   Eigen::Matrix<double, 6, 1> information_eigenvalues = Eigen::Matrix<double, 6, 1>::Zero();
+  /// The inverse covariance of the registered pose in the same tangent: J^T J / s^2 over all
+  /// residual rows, s^2 their mean square (each clipped at the Huber scale, as the loss
+  /// counts it). Zero where nothing was registered (the first scan, a failed solve).
+  Eigen::Matrix<double, 6, 6> precision = Eigen::Matrix<double, 6, 6>::Zero();
+  /// The scan was taken while the sensor stood still: its pose is the stand's (see
+  /// StandDetector), and it did not go into the local map.
+  bool standing = false;
 
   size_t scan_edges = 0;               ///< the scan's edges after the voxel filter
   size_t scan_surfaces = 0;            ///< the scan's surfaces after the voxel filter

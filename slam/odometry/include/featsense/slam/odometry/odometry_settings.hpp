@@ -29,6 +29,12 @@ struct OdometrySettings {
   /// Register the features deskewed to the scan's stamp with the motion being estimated
   /// (re-deskewed at every outer loop); false: as measured.
   bool deskew = detail::kDefaultOdometry.deskew;
+  /// Hold the pose while the sensor stands still (StandDetector).
+  bool hold_still = detail::kDefaultOdometry.hold_still;
+  /// Scans in a row whose motion stays within the registration's noise before a stand starts,
+  /// and registered beyond it before the stand ends (one outlier does not end one). No key.
+  int stand_enter_scans = 1;
+  int stand_leave_scans = 2;
 };
 
 /// The settings of config's odometry section.

@@ -72,6 +72,7 @@ enum class RefineOutcome {
   not_converged,  ///< kept the guess: the registration did not converge
   too_far,        ///< kept the guess: the result moved it beyond max_correction
   worse_fit,      ///< kept the guess: the result fits the target worse
+  stood,          ///< not registered: the odometry held the pose through it (standing still)
 };
 const char* to_string(RefineOutcome outcome);
 
@@ -94,6 +95,7 @@ struct RefineCounts {
   size_t not_converged = 0;
   size_t too_far = 0;
   size_t worse_fit = 0;
+  size_t stood = 0;  ///< stretches the sensor stood still through: nothing drifted to correct
   std::vector<StretchRegistration> stretches;
 };
 
