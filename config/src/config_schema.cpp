@@ -127,6 +127,40 @@ KeySpec vec3_key(std::string path, SectionOf<Section> section,
           }};
 }
 
+/// null, or [x_min, y_min, z_min, x_max, y_max, z_max] with each min below its max.
+template <typename Section>
+KeySpec optional_box_key(std::string path, SectionOf<Section> section,
+                         Member<Section, std::optional<std::array<double, 6>>> field) {
+  return {std::move(path),
+          [=](Config& c, const YAML::Node& v, const std::string& where) {
+            if (v.IsNull()) {
+              (c.*section).*field = std::nullopt;
+              return;
+            }
+            if (!v.IsSequence() || v.size() != 6)
+              fail(where, "expected null or [x_min, y_min, z_min, x_max, y_max, z_max]");
+            std::array<double, 6> box{};
+            for (size_t i = 0; i < 6; ++i) {
+              box[i] = parse_number(v[i], where + "[" + std::to_string(i) + "]", Range{});
+            }
+            for (size_t axis = 0; axis < 3; ++axis) {
+              if (!(box[axis] < box[axis + 3])) {
+                fail(where, std::string("the box's ") + "xyz"[axis] +
+                                " minimum must be below its maximum");
+              }
+            }
+            (c.*section).*field = box;
+          },
+          [=](const Config& c) {
+            const auto& box = (c.*section).*field;
+            if (!box) return YAML::Node(YAML::NodeType::Null);
+            YAML::Node node(YAML::NodeType::Sequence);
+            for (double x : *box) node.push_back(x);
+            node.SetStyle(YAML::EmitterStyle::Flow);
+            return node;
+          }};
+}
+
 std::string scalar_choice(const YAML::Node& v, const std::string& where,
                           const std::vector<std::string>& choices) {
   if (!v.IsScalar()) fail(where, "expected one of the names listed in default.yaml");
@@ -197,6 +231,7 @@ std::vector<KeySpec> make_specs() {
       bool_key("sensor.imu", &Config::sensor, &SensorConfig::imu),
       optional_path_key("sensor.imu_topic", &Config::sensor, &SensorConfig::imu_topic,
                         "a topic name"),
+      optional_box_key("sensor.self_box", &Config::sensor, &SensorConfig::self_box),
       vec3_key("sensor.imu_rotation", &Config::sensor, &SensorConfig::imu_rotation_deg,
                {-360.0, 360.0}),
       number_key("map.voxel_size", &Config::map, &MapConfig::voxel_size_m, {0.005, 2.0}),

@@ -95,6 +95,9 @@ TEST(Config, WrongTypesAreErrorsNamingTheKey) {
            {"sensor.imu_topic=[a,b]", "sensor.imu_topic"},
            {"sensor.imu_rotation=[0,0]", "sensor.imu_rotation"},
            {"sensor.imu_rotation=[0,.inf,0]", "finite"},
+           {"sensor.self_box=[0,0,0,1,1]", "sensor.self_box"},
+           {"sensor.self_box=[0,0,0,1,-1,1]", "y minimum must be below"},
+           {"sensor.self_box=box", "sensor.self_box"},
        }) {
     const std::string message = error_of([&] { load_config({}, {assignment}); });
     EXPECT_NE(message.find(key), std::string::npos) << assignment << " -> '" << message << "'";
@@ -209,6 +212,16 @@ TEST(Config, ValueTextIsShort) {
   EXPECT_EQ(value_text(c, "odometry.surface_voxel"), "0.4");
   EXPECT_NE(error_of([] { value_text(Config{}, "map.voxelsize"); }).find("map.voxel_size"),
             std::string::npos);
+}
+
+TEST(Config, TheSelfBoxIsNullOrSixNumbers) {
+  EXPECT_EQ(value_text(Config{}, "sensor.self_box"), "null");
+  const Config c = load_config({}, {"sensor.self_box=[-1, -0.8, -1.5, 2.5, 0.8, 0.2]"});
+  ASSERT_TRUE(c.sensor.self_box.has_value());
+  EXPECT_EQ((*c.sensor.self_box)[3], 2.5);
+  EXPECT_EQ(value_text(c, "sensor.self_box"), "[-1, -0.8, -1.5, 2.5, 0.8, 0.2]");
+  EXPECT_FALSE(load_config({}, {"sensor.self_box=[0,0,0,1,1,1]", "sensor.self_box=null"})
+                   .sensor.self_box.has_value());
 }
 
 TEST(Config, NullRangeMeansTheSensorsOwn) {

@@ -16,6 +16,7 @@ void expect_same(const slam::SourceOptions& a, const slam::SourceOptions& b) {
   EXPECT_EQ(a.sensor_preset, b.sensor_preset);
   EXPECT_EQ(a.min_range_m, b.min_range_m);
   EXPECT_EQ(a.max_range_m, b.max_range_m);
+  EXPECT_EQ(a.self_box, b.self_box);
   EXPECT_EQ(a.times_from_azimuth, b.times_from_azimuth);
   EXPECT_EQ(a.velodyne_calibration, b.velodyne_calibration);
   EXPECT_EQ(a.scan_cut_deg, b.scan_cut_deg);
@@ -53,6 +54,7 @@ TEST(MappingSettings, EverySensorKeyReachesTheReader) {
   config.sensor.preset = "vlp16";
   config.sensor.min_range_m = 0.5;
   config.sensor.max_range_m = 90.0;
+  config.sensor.self_box = std::array<double, 6>{-1.0, -0.8, -1.5, 2.5, 0.8, 0.2};
   config.sensor.times_from_azimuth = false;
   config.sensor.calibration = "calib.yaml";
   config.sensor.scan_cut_deg = 90.0;
@@ -65,6 +67,7 @@ TEST(MappingSettings, EverySensorKeyReachesTheReader) {
   expected.sensor_preset = "vlp16";
   expected.min_range_m = 0.5;
   expected.max_range_m = 90.0;
+  expected.self_box = std::array<double, 6>{-1.0, -0.8, -1.5, 2.5, 0.8, 0.2};
   expected.times_from_azimuth = false;
   expected.velodyne_calibration = "calib.yaml";
   expected.scan_cut_deg = 90.0;

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "common/test_data.hpp"
+#include "featsense/slam/io/box_room_source.hpp"
 #include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/scan_source.hpp"
 
@@ -71,6 +72,29 @@ TEST(OpenScanSource, RangeLimitsApplyToEveryReader) {
     ASSERT_GE(r, 2.0f);
     ASSERT_LE(r, 10.0f);
   }
+}
+
+TEST(OpenScanSource, TheSelfBoxDropsTheVehiclesOwnReturnsAndNothingElse) {
+  // A box around the sensor reaching 6 m forward and 2 m to each side (the OS1-128 sees the
+  // floor 1.5 m below from 3.6 m on): the room's floor returns inside it are dropped, every
+  // other return is kept as it was.
+  const std::array<double, 6> box{-1.0, -2.0, -2.0, 6.0, 2.0, 0.5};
+  auto boxed = with_range_limits(make_box_room_source(default_box_room()), 0.0, 1e9, box);
+  auto full = with_range_limits(make_box_room_source(default_box_room()), 0.0, 1e9);
+  const auto a = boxed->next();
+  const auto b = full->next();
+  ASSERT_TRUE(a && b);
+  ASSERT_EQ(a->size(), b->size());
+  size_t inside = 0;
+  for (size_t i = 0; i < b->size(); ++i) {
+    if (!b->valid[i]) continue;
+    const Eigen::Vector3f& p = b->xyz[i];
+    const bool in = p.x() >= -1.0f && p.x() <= 6.0f && p.y() >= -2.0f && p.y() <= 2.0f &&
+                    p.z() >= -2.0f && p.z() <= 0.5f;
+    inside += in ? 1 : 0;
+    EXPECT_EQ(static_cast<bool>(a->valid[i]), !in) << i;
+  }
+  EXPECT_GT(inside, 10u) << "the box must hold some of the room's returns for this test";
 }
 
 }  // namespace

@@ -17,8 +17,18 @@ namespace fs = std::filesystem;
 /// Drops returns outside [min, max] metres and any non-finite point, whatever the reader.
 class RangeLimitedSource final : public ScanSource {
  public:
-  RangeLimitedSource(std::unique_ptr<ScanSource> inner, double min_m, double max_m)
-      : inner_(std::move(inner)), min_m_(min_m), max_m_(max_m) {}
+  RangeLimitedSource(std::unique_ptr<ScanSource> inner, double min_m, double max_m,
+                     const std::optional<std::array<double, 6>>& self_box)
+      : inner_(std::move(inner)), min_m_(min_m), max_m_(max_m) {
+    if (self_box) {
+      const std::array<double, 6>& b = *self_box;
+      box_min_ = Eigen::Vector3f(static_cast<float>(b[0]), static_cast<float>(b[1]),
+                                 static_cast<float>(b[2]));
+      box_max_ = Eigen::Vector3f(static_cast<float>(b[3]), static_cast<float>(b[4]),
+                                 static_cast<float>(b[5]));
+      has_box_ = true;
+    }
+  }
 
   std::optional<Scan> next() override {
     std::optional<Scan> scan = inner_->next();
@@ -27,7 +37,11 @@ class RangeLimitedSource final : public ScanSource {
       if (!scan->valid[i]) continue;
       const Eigen::Vector3f& p = scan->xyz[i];
       const float r = p.norm();
-      if (!std::isfinite(r) || r < min_m_ || r > max_m_ || r == 0.0f) scan->invalidate(i);
+      if (!std::isfinite(r) || r < min_m_ || r > max_m_ || r == 0.0f ||
+          (has_box_ && (p.array() >= box_min_.array()).all() &&
+           (p.array() <= box_max_.array()).all())) {
+        scan->invalidate(i);
+      }
     }
     return scan;
   }
@@ -38,6 +52,9 @@ class RangeLimitedSource final : public ScanSource {
   std::unique_ptr<ScanSource> inner_;
   float min_m_;
   float max_m_;
+  bool has_box_ = false;
+  Eigen::Vector3f box_min_ = Eigen::Vector3f::Zero();
+  Eigen::Vector3f box_max_ = Eigen::Vector3f::Zero();
 };
 
 bool starts_with(std::string_view text, std::string_view prefix) {
@@ -117,12 +134,13 @@ std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
   const double min_m = options.min_range_m.value_or(sensor.min_range_m);
   const double max_m =
       options.max_range_m.value_or(sensor.max_range_m > 0.0 ? sensor.max_range_m : 1.0e9);
-  return with_range_limits(std::move(source), min_m, max_m);
+  return with_range_limits(std::move(source), min_m, max_m, options.self_box);
 }
 
-std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source, double min_m,
-                                              double max_m) {
-  return std::make_unique<RangeLimitedSource>(std::move(source), min_m, max_m);
+std::unique_ptr<ScanSource> with_range_limits(
+    std::unique_ptr<ScanSource> source, double min_m, double max_m,
+    const std::optional<std::array<double, 6>>& self_box) {
+  return std::make_unique<RangeLimitedSource>(std::move(source), min_m, max_m, self_box);
 }
 
 }  // namespace featsense::slam

@@ -14,6 +14,7 @@ slam::SourceOptions source_options(const config::Config& config,
   options.sensor_preset = config.sensor.preset;
   options.min_range_m = config.sensor.min_range_m;
   options.max_range_m = config.sensor.max_range_m;
+  options.self_box = config.sensor.self_box;
   options.times_from_azimuth = config.sensor.times_from_azimuth;
   options.velodyne_calibration = config.sensor.calibration;
   options.scan_cut_deg = config.sensor.scan_cut_deg;
@@ -32,7 +33,8 @@ std::unique_ptr<slam::ScanSource> open_recording(const std::string& path,
   if (config.sensor.preset != "auto") settings.sensor = config::sensor_preset(config.sensor.preset);
   return slam::with_range_limits(slam::make_box_room_source(settings),
                                  config.sensor.min_range_m.value_or(settings.sensor.min_range_m),
-                                 config.sensor.max_range_m.value_or(settings.sensor.max_range_m));
+                                 config.sensor.max_range_m.value_or(settings.sensor.max_range_m),
+                                 config.sensor.self_box);
 }
 
 }  // namespace featsense::mapping

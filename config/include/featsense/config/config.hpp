@@ -15,6 +15,10 @@ struct SensorConfig {
   std::string preset = "auto";
   std::optional<double> min_range_m;  ///< metres; unset: the sensor model's own limit
   std::optional<double> max_range_m;  ///< metres; unset: the sensor model's own limit
+  /// [x_min, y_min, z_min, x_max, y_max, z_max] in the sensor frame, metres: returns inside
+  /// are the vehicle carrying the sensor and are dropped before anything sees them. Unset:
+  /// none.
+  std::optional<std::array<double, 6>> self_box;
   /// Drop veil points between a foreground edge and the surface behind it.
   bool drop_mixed_pixels = true;
   /// Clouds without a per-point time field (KITTI .bin, many PCD / PLY files and

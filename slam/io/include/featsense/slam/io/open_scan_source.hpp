@@ -17,6 +17,8 @@ struct SourceOptions {
   std::string sensor_preset = config::SensorConfig{}.preset;  ///< config key sensor.preset
   std::optional<double> min_range_m;  ///< config key sensor.min_range (else the sensor's)
   std::optional<double> max_range_m;  ///< config key sensor.max_range (else the sensor's)
+  /// Config key sensor.self_box: returns inside this box of the sensor frame are dropped.
+  std::optional<std::array<double, 6>> self_box;
   /// Config key sensor.times_from_azimuth: clouds without a time field get per-point times
   /// from their points' azimuths (azimuth_times.hpp).
   bool times_from_azimuth = config::SensorConfig{}.times_from_azimuth;
@@ -37,9 +39,11 @@ struct SourceOptions {
 };
 
 /// Wraps `source` so that returns closer than min_m or farther than max_m (metres from the
-/// sensor) and non-finite points are invalid in every scan it hands out.
-std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source, double min_m,
-                                              double max_m);
+/// sensor), returns inside `self_box` ([x_min, y_min, z_min, x_max, y_max, z_max], sensor
+/// frame) and non-finite points are invalid in every scan it hands out.
+std::unique_ptr<ScanSource> with_range_limits(
+    std::unique_ptr<ScanSource> source, double min_m, double max_m,
+    const std::optional<std::array<double, 6>>& self_box = std::nullopt);
 
 /// Opens a recording, detecting its format from the content: an Ouster pcap, a ROS1 bag, a
 /// ROS 2 bag (a folder holding metadata.yaml, or one .db3), an MCAP file, a PCD or PLY
