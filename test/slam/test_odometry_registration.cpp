@@ -319,6 +319,50 @@ TEST(OdometryRegistration, ACorridorIsDegenerateAlongItsAxis) {
   EXPECT_LT(angle_between(r.T_map_sensor, want), 1e-6);
 }
 
+/// `f` with every point moved by Gaussian noise of `sigma_m` per axis (a seed per scan).
+FeatureSet with_noise(FeatureSet f, double sigma_m, unsigned seed) {
+  std::mt19937 random(seed);
+  std::normal_distribution<float> normal(0.0f, static_cast<float>(sigma_m));
+  for (auto* points : {&f.edges, &f.surfaces}) {
+    for (Eigen::Vector3f& p : *points)
+      p += Eigen::Vector3f(normal(random), normal(random), normal(random));
+  }
+  return f;
+}
+
+TEST(OdometryStand, AStandingSensorKeepsItsFirstPoseExactly) {
+  const Scene room = box_room();
+  FeatureOdometry odometry(defaults());
+  const Eigen::Isometry3d at = pose(0.3, 0, 0, {1, -1, 1.5});
+  odometry.register_scan(with_noise(observe(room, at, 0), 0.01, 1));
+  for (int i = 1; i < 20; ++i) {
+    const OdometryResult r =
+        odometry.register_scan(with_noise(observe(room, at, i * kFrame), 0.01, 1 + i));
+    EXPECT_TRUE(r.standing) << "scan " << i << ": " << r.reason;
+    EXPECT_TRUE(r.T_map_sensor.isApprox(Eigen::Isometry3d::Identity(), 1e-12)) << i;
+  }
+  // Walking off again: the registered pose, within two scans.
+  const OdometryResult a = odometry.register_scan(
+      with_noise(observe(room, at * pose(0, 0, 0, {0.1, 0, 0}), 20 * kFrame), 0.01, 30));
+  const OdometryResult b = odometry.register_scan(
+      with_noise(observe(room, at * pose(0, 0, 0, {0.2, 0, 0}), 21 * kFrame), 0.01, 31));
+  EXPECT_TRUE(a.standing);
+  EXPECT_FALSE(b.standing);
+  EXPECT_NEAR(b.T_map_sensor.translation().x(), 0.2, 0.01);
+}
+
+TEST(OdometryStand, ACorridorsUnobservedAxisNeverStartsAStand) {
+  // Walking along a corridor of two walls and a floor: along its axis the registration sees
+  // nothing, so it cannot tell walking from standing.
+  const Scene hall = corridor();
+  FeatureOdometry odometry(defaults());
+  for (int i = 0; i < 10; ++i) {
+    const OdometryResult r = odometry.register_scan(
+        with_noise(observe(hall, pose(0, 0, 0, {0.1 * i, 0, 1.2}), i * kFrame), 0.01, 40 + i));
+    EXPECT_FALSE(r.standing) << "scan " << i;
+  }
+}
+
 TEST(OdometryRobustness, EmptyScansAndOnePlaneGiveFinitePoses) {
   FeatureOdometry odometry(defaults());
   const OdometryResult empty = odometry.register_scan(FeatureSet{});

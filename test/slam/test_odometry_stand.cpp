@@ -44,12 +44,12 @@ TEST(MahalanobisStep, WeighsTheStepByBothPosesCovariances) {
   // Two equal covariances add up: 1 sigma of one is 1 / 2 in the sum's squared distance.
   EXPECT_NEAR(mahalanobis_step(from, p, moved_by(from, step), p, &dimensions), 0.5, 1e-9);
   EXPECT_EQ(dimensions, 6);
-  // A zero precision is an exact pose (the first scan: the map is defined by it).
-  EXPECT_NEAR(mahalanobis_step(from, Matrix6d::Zero(), moved_by(from, step), p, &dimensions), 1.0,
+  // A zero precision is the first scan's: its points are as noisy as the other's.
+  EXPECT_NEAR(mahalanobis_step(from, Matrix6d::Zero(), moved_by(from, step), p, &dimensions), 0.5,
               1e-9);
   step(3) = 0.0;
   step(2) = 0.002;  // two standard deviations of yaw
-  EXPECT_NEAR(mahalanobis_step(from, Matrix6d::Zero(), moved_by(from, step), p, &dimensions), 4.0,
+  EXPECT_NEAR(mahalanobis_step(from, Matrix6d::Zero(), moved_by(from, step), p, &dimensions), 2.0,
               1e-6);
 }
 

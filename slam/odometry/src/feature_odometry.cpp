@@ -117,7 +117,10 @@ FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
                                                        const RegistrationStart& start,
                                                        const Eigen::Isometry3d& pose,
                                                        const OdometryResult& result) const {
-  StillTest test{pose, result.precision, result.diagnostics.converged};
+  // A registration that leaves a direction unobserved (a corridor's axis) cannot tell a
+  // standing sensor from one moving along it: it neither starts a stand nor ends one.
+  StillTest test{pose, result.precision,
+                 result.diagnostics.converged && !result.diagnostics.degenerate};
   // Deskewing estimates the motion within the sweep from the scan itself: where the motion
   // is within a few times the noise it is mostly the noise, and the deskewed registration
   // scatters by more than its covariance says. Whether the sensor stands is asked of a rigid
@@ -132,7 +135,7 @@ FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
   rigid.deskew = false;
   OdometryResult rigid_result;
   const Eigen::Isometry3d rigid_pose = register_to_map(*map_, raw, rigid, settings_, rigid_result);
-  if (rigid_result.diagnostics.converged) {
+  if (rigid_result.diagnostics.converged && !rigid_result.diagnostics.degenerate) {
     test = StillTest{rigid_pose, rigid_result.precision, true};
   }
   return test;

@@ -21,7 +21,7 @@ struct Split {
 };
 
 /// The covariance of a precision over the directions it observes, and those it does not. A
-/// zero precision is an exact pose (the first scan: the map is defined by it).
+/// zero precision gives no covariance and no unobserved direction.
 Split split(const Matrix6d& precision) {
   Split out;
   if (precision.isZero(0.0)) return out;
@@ -50,8 +50,11 @@ double chi_squared_999(int dimensions) {
 double mahalanobis_step(const Eigen::Isometry3d& from, const Matrix6d& from_precision,
                         const Eigen::Isometry3d& to, const Matrix6d& to_precision,
                         int* dimensions) {
-  const Split a = split(from_precision);
+  // A zero precision is the first scan's: its pose defines the map exactly, but the map holds
+  // its points with their noise, so a registration to it is as uncertain as one between two
+  // registered scans.
   const Split b = split(to_precision);
+  const Split a = from_precision.isZero(0.0) ? b : split(from_precision);
   // The directions either leaves unobserved are dropped: project onto the rest.
   Matrix6d keep = Matrix6d::Identity();
   std::vector<Vector6d> unobserved = a.unobserved;

@@ -50,7 +50,7 @@ class FeatureOdometry {
   struct StillTest {
     Eigen::Isometry3d pose;
     Eigen::Matrix<double, 6, 6> precision;
-    bool converged;
+    bool converged;  ///< converged and observed in every direction
   };
   StillTest still_test(const TimedFeatures& raw, const RegistrationStart& start,
                        const Eigen::Isometry3d& pose, const OdometryResult& result) const;

@@ -27,7 +27,9 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 /// tangent [rotation (rad, about the sensor, map frame), translation (m, map frame)], under
 /// the sum of two covariances given as their inverses (the registrations' precision). Only
 /// directions that both observe count (a direction neither pins down says nothing about
-/// motion along it). Returns the distance and, in `dimensions`, how many directions counted.
+/// motion along it). A zero `from_precision` is the first scan's: exact as a pose, but its
+/// points in the map as noisy as any scan's, so `to_precision` stands for it. Returns the
+/// distance and, in `dimensions`, how many directions counted.
 double mahalanobis_step(const Eigen::Isometry3d& from, const Matrix6d& from_precision,
                         const Eigen::Isometry3d& to, const Matrix6d& to_precision, int* dimensions);
 
