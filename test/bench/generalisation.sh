@@ -6,7 +6,9 @@
 # usage: test/bench/generalisation.sh FEATSENSE WORKDIR [SCENE:PATH ...]
 #   FEATSENSE  the featsense program (e.g. build/app/featsense)
 #   WORKDIR    simulated recordings are kept there (re-used), maps written below it
-#   SCENE:PATH the runs (default: the list below); SCENE:PATH:STOP adds --stop STOP
+#   SCENE:PATH the runs (default: the list below); SCENE:PATH:STOP adds --stop STOP. A SCENE
+#              that is a mesh file takes a TUM file as PATH (--trajectory), e.g. the paths of
+#              test/bench/make_scene_paths.py
 # Prints one JSON object per run, then a Markdown table; writes WORKDIR/generalisation.json.
 set -euo pipefail
 featsense=$(realpath "$1")
@@ -22,11 +24,13 @@ results="$work/generalisation.jsonl"
 : >"$results"
 for run in "${runs[@]}"; do
   IFS=: read -r scene path stop <<<"$run"
-  name="${scene}_${path}${stop:+_stop${stop//,/_}}"
+  name="$(basename "${scene%.*}")_$(basename "${path%.*}")${stop:+_stop${stop//,/_}}"
   seq="$work/seq_$name"
+  route=(--path "$path")
+  [ -f "$scene" ] && route=(--trajectory "$path")
   if [ ! -f "$seq/gt_trajectory.tum" ]; then
     rm -rf "$seq"
-    "$featsense" simulate --scene "$scene" --path "$path" ${stop:+--stop "$stop"} -o "$seq" \
+    "$featsense" simulate --scene "$scene" "${route[@]}" ${stop:+--stop "$stop"} -o "$seq" \
       --quiet
   fi
   out="$work/map_$name"
