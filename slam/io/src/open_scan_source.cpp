@@ -14,7 +14,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Drops returns outside [min, max] metres and any non-finite point, whatever the reader.
+/// Drops returns outside [min, max] metres, inside the self box and any non-finite point,
+/// whatever the reader.
 class RangeLimitedSource final : public ScanSource {
  public:
   RangeLimitedSource(std::unique_ptr<ScanSource> inner, double min_m, double max_m,

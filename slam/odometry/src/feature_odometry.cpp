@@ -81,13 +81,12 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
 
   // Standing still: judged before the first map restarts (a sensor that stands needs no
   // deskewed first scan).
+  // The verdict's pose is read only while standing: otherwise the pose is this registration's.
   StandDetector::Verdict verdict;
-  verdict.pose = pose;
   if (registered && settings_.hold_still && result.elapsed_s > 0.0) {
     const StillTest still = still_test(raw, start, pose, result);
     verdict =
         stand_.update(last_pose_, last_precision_, still.pose, still.precision, still.converged);
-    if (!verdict.standing) verdict.pose = pose;
   }
   if (!verdict.standing && first_scan_ && result.diagnostics.converged && start.elapsed_s > 0.0) {
     pose = restart_map(raw, start, pose, imu, result);
@@ -125,7 +124,7 @@ FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
   // is within a few times the noise it is mostly the noise, and the deskewed registration
   // scatters by more than its covariance says. Whether the sensor stands is asked of a rigid
   // registration from the last pose instead: the hypothesis under test, measured as it is.
-  if (!start.deskew || !settings_.deskew || stand_.standing()) return test;
+  if (!start.deskew || !settings_.deskew) return test;  // rigid already (standing, or no deskew)
   int dimensions = 0;
   const double distance2 =
       mahalanobis_step(last_pose_, last_precision_, pose, result.precision, &dimensions);

@@ -58,10 +58,6 @@ class StandDetector {
                  bool registered_ok);
 
   bool standing() const { return standing_; }
-  /// The stand's pose (meaningful while standing()).
-  const Eigen::Isometry3d& anchor() const { return anchor_; }
-  /// How many scans in a row have left the noise about the anchor (while standing).
-  int scans_out() const { return out_; }
 
  private:
   int enter_scans_;
