@@ -6,10 +6,9 @@
 
 #include <vector>
 
-namespace featsense::slam::odometry {
+#include "featsense/slam/odometry/pose_tangent.hpp"
 
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+namespace featsense::slam::odometry {
 
 struct Degeneracy {
   Vector6d eigenvalues = Vector6d::Zero();       ///< of the information matrix, ascending

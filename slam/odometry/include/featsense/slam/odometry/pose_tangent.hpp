@@ -8,6 +8,7 @@
 namespace featsense::slam::odometry {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// The step from `from` to `to`: to = (Exp(w) R_from, t_from + dt).
 Vector6d tangent_between(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to);

@@ -19,9 +19,9 @@
 
 #include <cstddef>
 
-namespace featsense::slam::odometry {
+#include "featsense/slam/odometry/pose_tangent.hpp"
 
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+namespace featsense::slam::odometry {
 
 /// The squared Mahalanobis distance of the step from `from` to `to` in the registration's
 /// tangent [rotation (rad, about the sensor, map frame), translation (m, map frame)], under
