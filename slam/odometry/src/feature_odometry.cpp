@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "featsense/slam/odometry/local_feature_map.hpp"
 #include "featsense/slam/odometry/stand_detector.hpp"
+#include "featsense/slam/trajectory/gyro_rotation.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "scan_to_map.hpp"
 #include "timed_features.hpp"
@@ -59,8 +61,7 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
     start.twist = GyroTwist::from_samples(last_imu_, imu, last_stamp_ns_, features.stamp_ns,
                                           features.stamp_ns);
     if (result.elapsed_s > 0.0 && last_motion_s_ > 0.0) {
-      start.prediction =
-          last_pose_ * motion_fraction(last_motion_, result.elapsed_s / last_motion_s_);
+      start.prediction = last_pose_ * predicted_motion(features.stamp_ns, result.elapsed_s, imu);
     }
     if (!start.prediction.matrix().allFinite()) start.prediction = last_pose_;
     // Standing: the pose is held and the sweep rigid, until the registration says otherwise.
@@ -93,7 +94,10 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
   }
   first_scan_.reset();
   if (!started_ && !raw.empty()) first_scan_ = std::make_unique<TimedFeatures>(raw);
-  if (!started_ || result.elapsed_s > 0.0) last_imu_ = imu;
+  if (!started_ || result.elapsed_s > 0.0) {
+    earlier_imu_ = std::move(last_imu_);
+    last_imu_ = imu;
+  }
   if (verdict.standing) {
     hold(verdict.pose, features.stamp_ns, result);
     return result;
@@ -110,6 +114,21 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
   add_to_map(raw, SweepMotion(last_pose_.inverse() * pose, result.elapsed_s, start.twist), pose,
              features.stamp_ns, result);
   return result;
+}
+
+Eigen::Isometry3d FeatureOdometry::predicted_motion(int64_t stamp_ns, double elapsed_s,
+                                                    const std::vector<ImuSample>& imu) const {
+  const double ratio = elapsed_s / last_motion_s_;
+  const Eigen::Isometry3d constant_velocity = motion_fraction(last_motion_, ratio);
+  // A standing sensor predicts no motion; the gyroscope's bias would only turn it.
+  if (stand_.standing() || !settings_.gyro_prediction) return constant_velocity;
+  const int64_t period_ns = static_cast<int64_t>(std::llround(last_motion_s_ * 1e9));
+  const std::optional<Eigen::Matrix3d> turn_before =
+      gyro_rotation(earlier_imu_, last_imu_, last_stamp_ns_ - period_ns, last_stamp_ns_);
+  const std::optional<Eigen::Matrix3d> turn_now =
+      gyro_rotation(last_imu_, imu, last_stamp_ns_, stamp_ns);
+  if (!turn_before || !turn_now) return constant_velocity;
+  return gyro_corrected_prediction(constant_velocity, last_motion_, *turn_before, *turn_now, ratio);
 }
 
 FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,

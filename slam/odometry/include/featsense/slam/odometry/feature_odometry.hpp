@@ -38,7 +38,8 @@ class FeatureOdometry {
   /// With hold_still, a sensor that stands still (StandDetector) keeps the stand's pose and
   /// adds nothing to the map until its registration leaves the noise about that pose.
   /// `imu`: the IMU's samples of this sweep (Scan::imu), where the source has them: with
-  /// the last sweep's they bend the deskewing motion by the measured turn (SweepMotion).
+  /// the last sweep's they bend the deskewing motion by the measured turn (SweepMotion), and
+  /// with the two sweeps before they turn the prediction as the gyroscope measured.
   OdometryResult register_scan(const FeatureSet& features, const std::vector<ImuSample>& imu = {});
 
  private:
@@ -54,6 +55,10 @@ class FeatureOdometry {
   };
   StillTest still_test(const TimedFeatures& raw, const RegistrationStart& start,
                        const Eigen::Isometry3d& pose, const OdometryResult& result) const;
+  /// The motion from the last stamp to this one: the last motion at constant velocity, its
+  /// rotation the gyroscope's turn where the samples cover this period and the last.
+  Eigen::Isometry3d predicted_motion(int64_t stamp_ns, double elapsed_s,
+                                     const std::vector<ImuSample>& imu) const;
   void hold(const Eigen::Isometry3d& pose, int64_t stamp_ns, OdometryResult& result);
   void add_to_map(const TimedFeatures& raw, const SweepMotion& sweep, const Eigen::Isometry3d& pose,
                   int64_t stamp_ns, OdometryResult& result);
@@ -70,6 +75,8 @@ class FeatureOdometry {
   double last_motion_s_ = 0.0;
   /// The last sweep's IMU samples: the gyroscope's mean rate over the period before a stamp.
   std::vector<ImuSample> last_imu_;
+  /// The sweep's before it: with last_imu_, the gyroscope's turn over the last period.
+  std::vector<ImuSample> earlier_imu_;
   /// The last pose's precision (OdometryResult::precision), for the stand detector.
   Eigen::Matrix<double, 6, 6> last_precision_ = Eigen::Matrix<double, 6, 6>::Zero();
   StandDetector stand_;

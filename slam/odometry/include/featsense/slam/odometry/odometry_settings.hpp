@@ -31,6 +31,9 @@ struct OdometrySettings {
   bool deskew = detail::kDefaultOdometry.deskew;
   /// Hold the pose while the sensor stands still (StandDetector).
   bool hold_still = detail::kDefaultOdometry.hold_still;
+  /// Turn the prediction by the gyroscope where the scans carry IMU samples (see
+  /// gyro_rotation.hpp); false: constant velocity only. No key: always on, off for tests.
+  bool gyro_prediction = true;
   /// Scans in a row whose motion stays within the registration's noise before a stand starts,
   /// and registered beyond it before the stand ends (one outlier does not end one). No key.
   int stand_enter_scans = 1;
