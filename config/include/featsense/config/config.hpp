@@ -97,7 +97,7 @@ struct OdometryConfig {
   double map_radius_m = 50.0;    ///< map points farther than this from the sensor are dropped
   double max_correspondence_distance_m = 1.0;  ///< the 5 neighbours lie within this
   double huber_loss_m = 0.1;                   ///< residuals beyond this count linearly
-  double degeneracy_threshold = 0.02;          ///< see default.yaml
+  double degeneracy_threshold = 0.002;         ///< see default.yaml
   double max_speed_m_s = 30.0;  ///< larger corrections of the prediction are divergence
   double max_turn_rate_rad_s = 3.0;
 };
