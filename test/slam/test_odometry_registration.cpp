@@ -422,6 +422,25 @@ TEST(OdometryStand, ACorridorsUnobservedAxisNeverStartsAStand) {
   }
 }
 
+TEST(OdometryStand, AWeaklyObservedAxisNeverStartsAStand) {
+  // The corridor again, with an end wall 20 m ahead: the axis is observed (registered, not
+  // degenerate) but only by the few rows on that wall (J^T J / N about 0.01 along it). A
+  // sensor creeping along it at 8 cm/s moves within the noise bound of a stand; standing is
+  // claimed only where every direction is observed well, so it is not held.
+  Scene hall = corridor();
+  add_patch(hall.surfaces, {20, -1.5, 0}, {0, 3, 0}, {0, 0, 3}, 0.5);
+  FeatureOdometry odometry(defaults());
+  for (int i = 0; i < 10; ++i) {
+    const OdometryResult r = odometry.register_scan(
+        with_noise(observe(hall, pose(0, 0, 0, {0.008 * i, 0, 1.2}), i * kFrame), 0.01, 60 + i));
+    if (i > 0) {
+      EXPECT_FALSE(r.diagnostics.degenerate) << "scan " << i;
+      EXPECT_LT(r.information_eigenvalues.minCoeff(), 0.02) << "scan " << i;
+    }
+    EXPECT_FALSE(r.standing) << "scan " << i;
+  }
+}
+
 TEST(OdometryRobustness, EmptyScansAndOnePlaneGiveFinitePoses) {
   FeatureOdometry odometry(defaults());
   const OdometryResult empty = odometry.register_scan(FeatureSet{});

@@ -25,6 +25,16 @@ constexpr double kRestartSettledM = 2e-5;
 /// A deskewed registration whose motion lies within this many times the stand's bound
 /// (squared: 5 times the noise) is tried rigidly from the last pose for a stand.
 constexpr double kStillSearch = 25.0;
+/// A registration tells a standing sensor from a moving one only where it observes every
+/// direction well: J^T J / N at least this along each (2 % of the rows facing it head-on).
+/// Weaker directions are registered (odometry.degeneracy_threshold is lower), but their
+/// noise bound is wide enough to take a walk along a corridor for a stand.
+constexpr double kStandObservability = 0.02;
+
+bool observes_every_direction(const OdometryResult& r) {
+  return r.diagnostics.converged && !r.diagnostics.degenerate &&
+         r.information_eigenvalues.minCoeff() >= kStandObservability;
+}
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -135,10 +145,9 @@ FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
                                                        const RegistrationStart& start,
                                                        const Eigen::Isometry3d& pose,
                                                        const OdometryResult& result) const {
-  // A registration that leaves a direction unobserved (a corridor's axis) cannot tell a
-  // standing sensor from one moving along it: it neither starts a stand nor ends one.
-  StillTest test{pose, result.precision,
-                 result.diagnostics.converged && !result.diagnostics.degenerate};
+  // A registration that observes a direction weakly or not at all (a corridor's axis) cannot
+  // tell a standing sensor from one moving along it: it neither starts a stand nor ends one.
+  StillTest test{pose, result.precision, observes_every_direction(result)};
   // Deskewing estimates the motion within the sweep from the scan itself: where the motion
   // is within a few times the noise it is mostly the noise, and the deskewed registration
   // scatters by more than its covariance says. Whether the sensor stands is asked of a rigid
@@ -153,7 +162,7 @@ FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,
   rigid.deskew = false;
   OdometryResult rigid_result;
   const Eigen::Isometry3d rigid_pose = register_to_map(*map_, raw, rigid, settings_, rigid_result);
-  if (rigid_result.diagnostics.converged && !rigid_result.diagnostics.degenerate) {
+  if (observes_every_direction(rigid_result)) {
     test = StillTest{rigid_pose, rigid_result.precision, true};
   }
   return test;

@@ -51,7 +51,7 @@ class FeatureOdometry {
   struct StillTest {
     Eigen::Isometry3d pose;
     Eigen::Matrix<double, 6, 6> precision;
-    bool converged;  ///< converged and observed in every direction
+    bool converged;  ///< converged and observed well in every direction (see the source)
   };
   StillTest still_test(const TimedFeatures& raw, const RegistrationStart& start,
                        const Eigen::Isometry3d& pose, const OdometryResult& result) const;
