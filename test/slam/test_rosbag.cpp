@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -150,6 +151,46 @@ TEST(Rosbag, UnusualRowCountGetsAnEstimatedSensor) {
   SourceOptions options;
   options.sensor_preset = "os1-64";
   EXPECT_EQ(open_bag(path, options)->info().sensor.name, "os1-64");
+}
+
+/// One ring-less unorganized cloud of 64 beams from -24.8 to +2 deg (an HDL-64E's span), 360
+/// columns, 10 m away: a bag of two such messages on /points.
+std::string ringless_bag(const std::filesystem::path& dir) {
+  test::TestCloud cloud;
+  cloud.stamp_ns = kFirstStamp;
+  cloud.add_field("x", test::kFloat32);
+  cloud.add_field("y", test::kFloat32);
+  cloud.add_field("z", test::kFloat32);
+  cloud.allocate(1, 64 * 360);
+  for (int beam = 0; beam < 64; ++beam) {
+    const double elevation = (-24.8 + 26.8 * beam / 63.0) * M_PI / 180.0;
+    for (int col = 0; col < 360; ++col) {
+      const double azimuth = col * M_PI / 180.0;
+      const size_t i = static_cast<size_t>(beam * 360 + col);
+      cloud.set(i, "x", 10.0 * std::cos(elevation) * std::cos(azimuth));
+      cloud.set(i, "y", 10.0 * std::cos(elevation) * std::sin(azimuth));
+      cloud.set(i, "z", 10.0 * std::sin(elevation));
+    }
+  }
+  TestBagWriter writer(TestCompression::kNone);
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  writer.add_message(points, kFirstStamp, cloud.serialize());
+  writer.add_message(points, kFirstStamp + kFramePeriodNs, cloud.serialize());
+  return test::write_bag_file(dir, "ringless.bag", writer.finish());
+}
+
+TEST(Rosbag, APresetThePointsDoNotFitIsAnError) {
+  // A VLP-16 spans +-15 deg: the 36 % of the points below that would be lost from every scan.
+  const auto dir = test::scratch_dir("rosbag_preset_misfit");
+  const std::string path = ringless_bag(dir);
+  SourceOptions options;
+  options.sensor_preset = "vlp16";
+  const std::string what = error_of(path, options);
+  EXPECT_TRUE(contains(what, "outside the beams of sensor vlp16")) << what;
+  EXPECT_TRUE(contains(what, "/points")) << what;
+  EXPECT_TRUE(contains(what, "%")) << what;
+  // Without a preset the model comes from the points themselves and fits.
+  EXPECT_EQ(error_of(path), "");
 }
 
 TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {

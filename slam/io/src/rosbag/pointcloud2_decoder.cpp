@@ -2,8 +2,10 @@
 
 #include <utility>
 
+#include "cloud/cloud_file_io.hpp"
 #include "cloud/sensor_guess.hpp"
 #include "featsense/slam/io/azimuth_times.hpp"
+#include "featsense/slam/io/organize.hpp"
 #include "ros2/cdr_pointcloud2.hpp"
 #include "rosbag/cloud_sensor_model.hpp"
 #include "rosbag/pointcloud2.hpp"
@@ -180,6 +182,17 @@ std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& 
   std::string how;
   config::SensorModel sensor = choose_sensor(context, first, sensor_for, how);
   if (first.organized) sensor.columns = static_cast<int>(first.width);
+  // Clouds placed by the elevations of their points: a model most of them fall outside of
+  // would map what is left of every scan. As for clouds in files, that is an error naming
+  // the share lost and the presets whose beams the points lie on.
+  if (!first.organized && first.rings == 0) {
+    PointCloud points;
+    points.xyz = first.xyz;
+    OrganizeStats stats;
+    slam::organize(points, sensor, &stats);  // the parameter of that name is the per-scan one
+    cloud::check_sensor_fits(stats, points, sensor,
+                             context.origin + ", topic " + context.topic.name);
+  }
   info.sensor = sensor;
   info.sensor_from_metadata = false;
   info.fields = first.fields;
