@@ -193,6 +193,27 @@ TEST(Rosbag, APresetThePointsDoNotFitIsAnError) {
   EXPECT_EQ(error_of(path), "");
 }
 
+TEST(Rosbag, RingsBeyondThePresetsBeamsAreAnError) {
+  // Reference clouds of 32 rings flattened into one row, read as a VLP-16: rings 16-31 have
+  // no beam, half of every scan. By their rings alone they are an HDL-32E, which fits.
+  const auto dir = test::scratch_dir("rosbag_rings_misfit");
+  CloudSpec spec;
+  spec.rows = 32;
+  test::TestCloud cloud = test::make_reference_cloud(spec);
+  cloud.width *= cloud.height;
+  cloud.height = 1;
+  cloud.row_step = cloud.width * cloud.point_step;
+  TestBagWriter writer(TestCompression::kNone);
+  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
+  writer.add_message(points, kFirstStamp, cloud.serialize());
+  const std::string path = test::write_bag_file(dir, "rings.bag", writer.finish());
+  SourceOptions options;
+  options.sensor_preset = "vlp16";
+  const std::string what = error_of(path, options);
+  EXPECT_TRUE(contains(what, "outside the beams of sensor vlp16")) << what;
+  EXPECT_EQ(error_of(path), "");
+}
+
 TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {
   const auto dir = test::scratch_dir("rosbag_unorganized");
   // The reference scene flattened into one row, rings numbered from the lowest beam up.

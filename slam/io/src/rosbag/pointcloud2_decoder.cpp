@@ -40,6 +40,9 @@ struct FirstCloud {
   int rings = 0;
   std::optional<Scan> organized;     ///< row 0 the highest beam
   std::vector<Eigen::Vector3f> xyz;  ///< the points in the order the message stores them
+  /// An unorganized cloud's points as the organizer gets them (rings included), for the check
+  /// that they fit the sensor.
+  PointCloud points;
 };
 
 FirstCloud read_first_cloud(const BagTopicContext& context) {
@@ -64,7 +67,8 @@ FirstCloud read_first_cloud(const BagTopicContext& context) {
           first.xyz = first.organized->xyz;
           if (rows_lowest_first(*first.organized).value_or(false)) flip_rows(*first.organized);
         } else {
-          first.xyz = cloud_to_points(cloud, message->time_ns).xyz;
+          first.points = cloud_to_points(cloud, message->time_ns);
+          first.xyz = first.points.xyz;
         }
         return first;
       }
@@ -182,15 +186,14 @@ std::unique_ptr<BagScanDecoder> make_pointcloud2_decoder(const BagTopicContext& 
   std::string how;
   config::SensorModel sensor = choose_sensor(context, first, sensor_for, how);
   if (first.organized) sensor.columns = static_cast<int>(first.width);
-  // Clouds placed by the elevations of their points: a model most of them fall outside of
-  // would map what is left of every scan. As for clouds in files, that is an error naming
-  // the share lost and the presets whose beams the points lie on.
-  if (!first.organized && first.rings == 0) {
-    PointCloud points;
-    points.xyz = first.xyz;
+  // Unorganized clouds are placed by their rings or their points' elevations: a model most of
+  // them fall outside of would map what is left of every scan. As for clouds in files, that
+  // is an error naming the share lost and the presets whose beams the points lie on.
+  if (!first.organized) {
     OrganizeStats stats;
-    slam::organize(points, sensor, &stats);  // the parameter of that name is the per-scan one
-    cloud::check_sensor_fits(stats, points, sensor,
+    // The parameter `organize` is the per-scan organizer; the check uses the library's.
+    slam::organize(first.points, sensor, &stats);
+    cloud::check_sensor_fits(stats, first.points, sensor,
                              context.origin + ", topic " + context.topic.name);
   }
   info.sensor = sensor;
