@@ -3,30 +3,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gyro_samples.hpp"
+
 namespace featsense::slam {
 namespace {
 
-Eigen::Matrix3d exp_so3(const Eigen::Vector3d& rotation_vector) {
-  const double angle = rotation_vector.norm();
-  if (!(angle > 0.0)) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, rotation_vector / angle).toRotationMatrix();
-}
-
-struct RateSample {
-  double t_s;
-  Eigen::Vector3d rate;
-};
-
 /// The rate at t: linear between samples, constant beyond the ends.
-Eigen::Vector3d rate_at(const std::vector<RateSample>& s, double t) {
-  if (t <= s.front().t_s) return s.front().rate;
-  if (t >= s.back().t_s) return s.back().rate;
-  const auto after = std::upper_bound(s.begin(), s.end(), t,
-                                      [](double x, const RateSample& r) { return x < r.t_s; });
-  const RateSample& b = *after;
-  const RateSample& a = *(after - 1);
-  const double w = (t - a.t_s) / (b.t_s - a.t_s);
-  return (1.0 - w) * a.rate + w * b.rate;
+Eigen::Vector3d rate_at(const gyro::Rates& s, double t) {
+  const std::vector<double>& times = s.times_s;
+  if (t <= times.front()) return s.rates.front();
+  if (t >= times.back()) return s.rates.back();
+  const size_t b =
+      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  const size_t a = b - 1;
+  const double w = (t - times[a]) / (times[b] - times[a]);
+  return (1.0 - w) * s.rates[a] + w * s.rates[b];
 }
 
 }  // namespace
@@ -36,26 +27,16 @@ std::optional<Eigen::Matrix3d> gyro_rotation(const std::vector<ImuSample>& earli
                                              int64_t to_ns) {
   const double period_s = static_cast<double>(to_ns - from_ns) * 1e-9;
   if (!(period_s > 0.0)) return std::nullopt;
-  std::vector<RateSample> samples;
-  for (const std::vector<ImuSample>* part : {&earlier, &later}) {
-    for (const ImuSample& sample : *part) {
-      const double t = static_cast<double>(sample.stamp_ns - from_ns) * 1e-9;
-      // A sample out of order or repeated, or not a number, says nothing reliable.
-      if (!sample.gyro_radps.allFinite() || (!samples.empty() && !(t > samples.back().t_s))) {
-        continue;
-      }
-      samples.push_back({t, sample.gyro_radps});
-    }
-  }
+  const gyro::Rates samples = gyro::merged_rates(earlier, later, from_ns);
   const double max_gap_s = 0.5 * period_s;
-  if (samples.size() < 2 || samples.front().t_s > max_gap_s ||
-      samples.back().t_s < period_s - max_gap_s) {
+  const std::vector<double>& times = samples.times_s;
+  if (times.size() < 2 || times.front() > max_gap_s || times.back() < period_s - max_gap_s) {
     return std::nullopt;
   }
   // The knots: the period's ends and the samples within it.
   std::vector<double> knots{0.0};
-  for (const RateSample& s : samples) {
-    if (s.t_s > 0.0 && s.t_s < period_s) knots.push_back(s.t_s);
+  for (const double t : times) {
+    if (t > 0.0 && t < period_s) knots.push_back(t);
   }
   knots.push_back(period_s);
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -65,7 +46,7 @@ std::optional<Eigen::Matrix3d> gyro_rotation(const std::vector<ImuSample>& earli
     // The midpoint rule on a linear rate is exact for the rate's integral.
     const Eigen::Vector3d mean_rate =
         0.5 * (rate_at(samples, knots[k - 1]) + rate_at(samples, knots[k]));
-    rotation = rotation * exp_so3(mean_rate * dt);
+    rotation = rotation * gyro::rotation_of(mean_rate * dt);
   }
   return rotation;
 }
@@ -76,7 +57,7 @@ Eigen::Isometry3d gyro_corrected_prediction(const Eigen::Isometry3d& predicted,
                                             const Eigen::Matrix3d& turn_now, double ratio) {
   // The gyroscope's error over the last period, as a rotation to apply after its turn.
   const Eigen::AngleAxisd bias(turn_before.transpose() * last_motion.linear());
-  const Eigen::Matrix3d bias_now = exp_so3(ratio * bias.angle() * bias.axis());
+  const Eigen::Matrix3d bias_now = gyro::rotation_of(ratio * bias.angle() * bias.axis());
   Eigen::Isometry3d corrected = predicted;
   corrected.linear() = turn_now * bias_now;
   return corrected;

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
+#include "gyro_samples.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -23,12 +24,6 @@ Eigen::Vector3d integral_at(const std::vector<double>& t, const std::vector<Eige
   return integral[k] + r[k] * d + (r[k + 1] - r[k]) * (0.5 * d * d / h);
 }
 
-Eigen::Matrix3d rotation_of(const Eigen::Vector3d& rotation_vector) {
-  const double angle = rotation_vector.norm();
-  if (!(angle > 0.0)) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, rotation_vector / angle).toRotationMatrix();
-}
-
 }  // namespace
 
 GyroTwist GyroTwist::from_samples(const std::vector<ImuSample>& earlier,
@@ -42,17 +37,9 @@ GyroTwist GyroTwist::from_samples(const std::vector<ImuSample>& earlier,
   const double to_s = from_s + period_s;
   const double needed_from_s = std::min(from_s, 0.0);
   const double needed_to_s = std::max(to_s, 0.5 * period_s);
-  std::vector<double> t;
-  std::vector<Eigen::Vector3d> rate;
-  for (const std::vector<ImuSample>* part : {&earlier, &later}) {
-    for (const ImuSample& sample : *part) {
-      const double time_s = static_cast<double>(sample.stamp_ns - stamp_ns) * 1e-9;
-      // A sample out of order or repeated, or not a number, says nothing reliable.
-      if (!sample.gyro_radps.allFinite() || (!t.empty() && !(time_s > t.back()))) continue;
-      t.push_back(time_s);
-      rate.push_back(sample.gyro_radps);
-    }
-  }
+  gyro::Rates merged = gyro::merged_rates(earlier, later, stamp_ns);
+  std::vector<double>& t = merged.times_s;
+  std::vector<Eigen::Vector3d>& rate = merged.rates;
   // The rate must be known over the period (for its mean) and over the sweep's first half at
   // least: no gap of more than half a period.
   const double max_gap_s = 0.5 * period_s;
@@ -96,7 +83,7 @@ Eigen::Isometry3d SweepMotion::at(double t_s) const {
   const double s = t_s / period_s_;
   if (twist_.empty()) return motion_fraction(motion_, s);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rotation_of(s * rotation_vector_ + twist_.at(t_s));
+  pose.linear() = gyro::rotation_of(s * rotation_vector_ + twist_.at(t_s));
   pose.translation() = s * motion_.translation();
   return pose;
 }
