@@ -153,6 +153,28 @@ TEST(Rosbag, UnusualRowCountGetsAnEstimatedSensor) {
   EXPECT_EQ(open_bag(path, options)->info().sensor.name, "os1-64");
 }
 
+/// The reference cloud of `spec` flattened into one row: an unorganized cloud with rings.
+test::TestCloud flattened_reference_cloud(const CloudSpec& spec) {
+  test::TestCloud cloud = test::make_reference_cloud(spec);
+  cloud.width *= cloud.height;
+  cloud.height = 1;
+  cloud.row_step = cloud.width * cloud.point_step;
+  return cloud;
+}
+
+/// A bag file of `messages` copies of `cloud` on `topic`, one frame period apart.
+std::string one_cloud_bag(const std::filesystem::path& dir, const std::string& name,
+                          const test::TestCloud& cloud, int messages,
+                          const std::string& topic = "/points",
+                          TestCompression compression = TestCompression::kNone) {
+  TestBagWriter writer(compression);
+  const uint32_t points = writer.add_connection(topic, "sensor_msgs/PointCloud2");
+  for (int k = 0; k < messages; ++k) {
+    writer.add_message(points, kFirstStamp + k * kFramePeriodNs, cloud.serialize());
+  }
+  return test::write_bag_file(dir, name, writer.finish());
+}
+
 /// One ring-less unorganized cloud of 64 beams from -24.8 to +2 deg (an HDL-64E's span), 360
 /// columns, 10 m away: a bag of two such messages on /points.
 std::string ringless_bag(const std::filesystem::path& dir) {
@@ -172,11 +194,7 @@ std::string ringless_bag(const std::filesystem::path& dir) {
       cloud.set(i, "z", 10.0 * std::sin(elevation));
     }
   }
-  TestBagWriter writer(TestCompression::kNone);
-  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
-  writer.add_message(points, kFirstStamp, cloud.serialize());
-  writer.add_message(points, kFirstStamp + kFramePeriodNs, cloud.serialize());
-  return test::write_bag_file(dir, "ringless.bag", writer.finish());
+  return one_cloud_bag(dir, "ringless.bag", cloud, 2);
 }
 
 TEST(Rosbag, APresetThePointsDoNotFitIsAnError) {
@@ -199,14 +217,7 @@ TEST(Rosbag, RingsBeyondThePresetsBeamsAreAnError) {
   const auto dir = test::scratch_dir("rosbag_rings_misfit");
   CloudSpec spec;
   spec.rows = 32;
-  test::TestCloud cloud = test::make_reference_cloud(spec);
-  cloud.width *= cloud.height;
-  cloud.height = 1;
-  cloud.row_step = cloud.width * cloud.point_step;
-  TestBagWriter writer(TestCompression::kNone);
-  const uint32_t points = writer.add_connection("/points", "sensor_msgs/PointCloud2");
-  writer.add_message(points, kFirstStamp, cloud.serialize());
-  const std::string path = test::write_bag_file(dir, "rings.bag", writer.finish());
+  const std::string path = one_cloud_bag(dir, "rings.bag", flattened_reference_cloud(spec), 1);
   SourceOptions options;
   options.sensor_preset = "vlp16";
   const std::string what = error_of(path, options);
@@ -219,15 +230,9 @@ TEST(Rosbag, UnorganizedCloudsGoToTheOrganizer) {
   // The reference scene flattened into one row, rings numbered from the lowest beam up.
   CloudSpec spec;
   spec.lowest_first = true;
-  test::TestCloud cloud = test::make_reference_cloud(spec);
-  cloud.width *= cloud.height;
-  cloud.height = 1;
-  cloud.row_step = cloud.width * cloud.point_step;
-  TestBagWriter writer(TestCompression::kBz2);
-  const uint32_t points = writer.add_connection("/velodyne_points", "sensor_msgs/PointCloud2");
-  writer.add_message(points, kFirstStamp, cloud.serialize());
-  writer.add_message(points, kFirstStamp + kFramePeriodNs, cloud.serialize());
-  const std::string path = test::write_bag_file(dir, "u.bag", writer.finish());
+  const test::TestCloud cloud = flattened_reference_cloud(spec);
+  const std::string path =
+      one_cloud_bag(dir, "u.bag", cloud, 2, "/velodyne_points", TestCompression::kBz2);
 
   test::StandInLog log;
   const std::unique_ptr<ScanSource> source =
