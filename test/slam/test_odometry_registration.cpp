@@ -225,6 +225,43 @@ TEST(OdometryRegistration, WithoutDeskewingTheMovingSensorIsNotRecovered) {
   EXPECT_GT(worst, 0.01);
 }
 
+/// What a spinning sensor on the path `truth_at` (seconds -> map <- sensor) sees in one 0.1 s
+/// sweep from `stamp_s`: a point's time is its clockwise azimuth's share of the turn, and it
+/// is measured from the pose at that time.
+FeatureSet observe_sweep(const Scene& scene,
+                         const std::function<Eigen::Isometry3d(double)>& truth_at, double stamp_s,
+                         int64_t stamp_ns) {
+  FeatureSet f;
+  f.stamp_ns = stamp_ns;
+  const auto measure = [&](const Eigen::Vector3d& p, std::vector<Eigen::Vector3f>& points,
+                           std::vector<float>& times) {
+    const Eigen::Vector3d at_stamp = truth_at(stamp_s).inverse() * p;
+    if (at_stamp.norm() >= 30.0) return;
+    double clockwise = -std::atan2(at_stamp.y(), at_stamp.x());
+    if (clockwise < 0.0) clockwise += 2.0 * M_PI;
+    const double time = clockwise / (2.0 * M_PI) * 0.1;
+    points.push_back((truth_at(stamp_s + time).inverse() * p).cast<float>());
+    times.push_back(static_cast<float>(time));
+  };
+  for (const auto& p : scene.surfaces) measure(p, f.surfaces, f.surface_time_s);
+  for (const auto& p : scene.edges) measure(p, f.edges, f.edge_time_s);
+  return f;
+}
+
+/// 100 Hz gyroscope samples of that sweep: the yaw rate `rate_at` (seconds -> rad/s) plus a
+/// bias of 0.6 deg/s.
+std::vector<ImuSample> sweep_gyro(const std::function<double(double)>& rate_at, double stamp_s,
+                                  int64_t stamp_ns) {
+  std::vector<ImuSample> gyro;
+  for (int k = 0; k < 10; ++k) {
+    ImuSample sample;
+    sample.stamp_ns = stamp_ns + k * 10'000'000;
+    sample.gyro_radps = Eigen::Vector3d(0.0, 0.0, rate_at(stamp_s + 0.01 * k) + 0.01);
+    gyro.push_back(sample);
+  }
+  return gyro;
+}
+
 /// A sensor entering a corner: yaw 0.3 t + 1.15 t^2 rad (speeding up at 130 deg/s^2, as a
 /// car does) while it drives 3 m/s along x, seen from 10 Hz sweeps in the box room, each point
 /// measured from the pose at its own time. With `imu` each scan carries 100 Hz gyroscope
@@ -241,29 +278,10 @@ double corner_yaw_error(bool imu) {
   double worst = 0.0;
   for (int i = 0; i < 10; ++i) {
     const double stamp_s = 0.1 * i;
-    FeatureSet f;
-    f.stamp_ns = i * kFrame;
-    const auto measure = [&](const Eigen::Vector3d& p, std::vector<Eigen::Vector3f>& points,
-                             std::vector<float>& times) {
-      const Eigen::Vector3d at_stamp = truth_at(stamp_s).inverse() * p;
-      if (at_stamp.norm() >= 30.0) return;
-      double clockwise = -std::atan2(at_stamp.y(), at_stamp.x());
-      if (clockwise < 0.0) clockwise += 2.0 * M_PI;
-      const double time = clockwise / (2.0 * M_PI) * 0.1;
-      points.push_back((truth_at(stamp_s + time).inverse() * p).cast<float>());
-      times.push_back(static_cast<float>(time));
-    };
-    for (const auto& p : room.surfaces) measure(p, f.surfaces, f.surface_time_s);
-    for (const auto& p : room.edges) measure(p, f.edges, f.edge_time_s);
-    std::vector<ImuSample> gyro;
-    for (int k = 0; imu && k < 10; ++k) {
-      const double t = stamp_s + 0.01 * k;
-      ImuSample sample;
-      sample.stamp_ns = f.stamp_ns + k * 10'000'000;
-      sample.gyro_radps = Eigen::Vector3d(0.0, 0.0, 0.3 + 2.3 * t + 0.01);
-      gyro.push_back(sample);
-    }
-    const OdometryResult r = odometry.register_scan(f, gyro);
+    const FeatureSet f = observe_sweep(room, truth_at, stamp_s, i * kFrame);
+    const auto rate_at = [](double t) { return 0.3 + 2.3 * t; };
+    const OdometryResult r = odometry.register_scan(
+        f, imu ? sweep_gyro(rate_at, stamp_s, f.stamp_ns) : std::vector<ImuSample>());
     EXPECT_TRUE(r.diagnostics.converged) << i << ": " << r.reason;
     const Eigen::Isometry3d truth = start.inverse() * truth_at(stamp_s);
     if (i >= 2) worst = std::max(worst, angle_between(r.T_map_sensor, truth));
@@ -301,28 +319,8 @@ double whip_turn_error(bool gyro_prediction) {
   double worst = 0.0;
   for (int i = 0; i < 8; ++i) {
     const double stamp_s = 0.1 * i;
-    FeatureSet f;
-    f.stamp_ns = i * kFrame;
-    const auto measure = [&](const Eigen::Vector3d& p, std::vector<Eigen::Vector3f>& points,
-                             std::vector<float>& times) {
-      const Eigen::Vector3d at_stamp = truth_at(stamp_s).inverse() * p;
-      if (at_stamp.norm() >= 30.0) return;
-      double clockwise = -std::atan2(at_stamp.y(), at_stamp.x());
-      if (clockwise < 0.0) clockwise += 2.0 * M_PI;
-      const double time = clockwise / (2.0 * M_PI) * 0.1;
-      points.push_back((truth_at(stamp_s + time).inverse() * p).cast<float>());
-      times.push_back(static_cast<float>(time));
-    };
-    for (const auto& p : room.surfaces) measure(p, f.surfaces, f.surface_time_s);
-    for (const auto& p : room.edges) measure(p, f.edges, f.edge_time_s);
-    std::vector<ImuSample> gyro;
-    for (int k = 0; k < 10; ++k) {
-      ImuSample sample;
-      sample.stamp_ns = f.stamp_ns + k * 10'000'000;
-      sample.gyro_radps = Eigen::Vector3d(0.0, 0.0, rate_at(stamp_s + 0.01 * k) + 0.01);
-      gyro.push_back(sample);
-    }
-    const OdometryResult r = odometry.register_scan(f, gyro);
+    const FeatureSet f = observe_sweep(room, truth_at, stamp_s, i * kFrame);
+    const OdometryResult r = odometry.register_scan(f, sweep_gyro(rate_at, stamp_s, f.stamp_ns));
     const Eigen::Isometry3d truth = start.inverse() * truth_at(stamp_s);
     // The scans after the one the turn started in: predicted from a period that turned.
     if (i >= 4) worst = std::max(worst, angle_between(r.T_map_sensor, truth));
