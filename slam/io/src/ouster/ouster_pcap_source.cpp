@@ -12,8 +12,8 @@
 #include "featsense/slam/io/ouster_frame_assembler.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "imu_sweep_assigner.hpp"
+#include "net/pcap_datagram_feed.hpp"
 #include "ouster/ouster_imu_packet.hpp"
-#include "ouster/pcap_udp_reader.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -66,34 +66,25 @@ fs::path find_metadata(const fs::path& pcap) {
   return best.front();
 }
 
-std::unique_ptr<std::ifstream> open_pcap_stream(const std::string& path,
-                                                std::vector<char>* buffer) {
-  auto stream = std::make_unique<std::ifstream>();
-  // A large stream buffer: a lidar packet is 8 to 25 KB, the default buffer far smaller.
-  buffer->resize(1 << 20);
-  stream->rdbuf()->pubsetbuf(buffer->data(), static_cast<std::streamsize>(buffer->size()));
-  stream->open(path, std::ios::binary);
-  if (!*stream) throw InputError(path + ": cannot open (missing or permission denied?)");
-  return stream;
-}
-
-class OusterPcapSource final : public ScanSource {
+/// An Ouster sensor's packets, from a pcap file or from the network.
+class OusterPacketSource final : public ScanSource {
  public:
-  OusterPcapSource(const std::string& path, const fs::path& meta_path, OusterMetadata metadata,
-                   bool read_imu)
-      : stream_(open_pcap_stream(path, &stream_buffer_)),
-        udp_(*stream_, path),
+  /// `imu_port`: the port the IMU packets arrive on (else the metadata's udp_port_imu).
+  OusterPacketSource(std::unique_ptr<detail::DatagramFeed> feed, std::string format,
+                     const fs::path& meta_path, OusterMetadata metadata, bool read_imu,
+                     std::optional<int> imu_port = std::nullopt)
+      : feed_(std::move(feed)),
         assembler_(std::move(metadata)),
         imu_(detail::sweep_duration_ns(assembler_.metadata().rate_hz)),
         read_imu_(read_imu),
-        path_(path),
+        path_(feed_->origin()),
         meta_path_(meta_path.string()) {
     const OusterMetadata& meta = assembler_.metadata();
     packet_size_ = meta.packet_size();
-    imu_port_ = meta.udp_port_imu;
+    imu_port_ = imu_port.value_or(meta.udp_port_imu);
     imu_to_sensor_ = detail::ouster_imu_to_sensor_rotation(meta);
-    info_.format = "ouster-pcap";
-    info_.path = path;
+    info_.format = std::move(format);
+    info_.path = path_;
     info_.sensor = meta.sensor_model();
     try {
       info_.sensor.validate();
@@ -141,7 +132,7 @@ class OusterPcapSource final : public ScanSource {
   /// pending_), an IMU packet to the IMU's samples; at the end of the capture the frame in
   /// progress completes.
   void read_datagram() {
-    std::optional<detail::UdpDatagram> datagram = udp_.next();
+    std::optional<detail::UdpDatagram> datagram = feed_->next();
     if (!datagram) {
       end_of_capture();
       return;
@@ -166,15 +157,7 @@ class OusterPcapSource final : public ScanSource {
 
   void end_of_capture() {
     ended_ = true;
-    if (udp_.problem()) warn(*udp_.problem());
-    if (udp_.stats().malformed > 0) {
-      warn(path_ + ": " + std::to_string(udp_.stats().malformed) +
-           " IP/UDP packets were damaged or cut short by the capture's snap length; skipped");
-    }
-    if (udp_.incomplete_datagrams() > 0) {
-      warn(path_ + ": " + std::to_string(udp_.incomplete_datagrams()) +
-           " fragmented IP datagrams could not be reassembled (fragments missing)");
-    }
+    for (const std::string& warning : feed_->end_warnings()) warn(warning);
     if (malformed_imu_packets_ > 0) {
       warn(path_ + ": " + std::to_string(malformed_imu_packets_) + " packets on the IMU port " +
            std::to_string(imu_port_) + " were not " +
@@ -232,15 +215,13 @@ class OusterPcapSource final : public ScanSource {
         message += ". Is the metadata the one of this recording?";
       }
     }
-    if (udp_.problem()) message += " [" + *udp_.problem() + "]";
+    if (feed_->problem()) message += " [" + *feed_->problem() + "]";
     return message;
   }
 
   static constexpr size_t kMaxSizesKept = 8;
 
-  std::vector<char> stream_buffer_;
-  std::unique_ptr<std::ifstream> stream_;
-  detail::PcapUdpReader udp_;
+  std::unique_ptr<detail::DatagramFeed> feed_;
   OusterFrameAssembler assembler_;
   std::deque<Scan> pending_;  ///< completed frames not handed out yet
   detail::ImuSweepAssigner imu_;
@@ -266,7 +247,9 @@ std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path,
   // The metadata describes this very unit, so it wins over options.sensor_preset.
   const fs::path meta_path = options.meta_path ? fs::path(*options.meta_path) : find_metadata(path);
   OusterMetadata metadata = parse_ouster_metadata(read_text_file(meta_path), meta_path.string());
-  return std::make_unique<OusterPcapSource>(path, meta_path, std::move(metadata), options.imu);
+  return std::make_unique<OusterPacketSource>(std::make_unique<detail::PcapDatagramFeed>(path),
+                                              "ouster-pcap", meta_path, std::move(metadata),
+                                              options.imu);
 }
 
 }  // namespace featsense::slam

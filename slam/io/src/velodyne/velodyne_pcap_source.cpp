@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "featsense/slam/io/readers.hpp"
+#include "net/pcap_datagram_feed.hpp"
 #include "ouster/pcap_udp_reader.hpp"
 #include "velodyne/velodyne_setup.hpp"
 
@@ -15,14 +16,14 @@ namespace {
 /// UDP datagrams looked at to tell a Velodyne capture from an Ouster one.
 constexpr size_t kProbeDatagrams = 64;
 
-class VelodynePcapSource final : public ScanSource {
+/// A Velodyne sensor's data packets, from a pcap file or from the network.
+class VelodynePacketSource final : public ScanSource {
  public:
-  VelodynePcapSource(const std::string& path, const VelodyneSetup& setup)
-      : stream_(path, std::ios::binary),
-        reader_(stream_, path),
-        assembler_(make_velodyne_assembler(setup)) {
-    info_.format = "velodyne-pcap";
-    info_.path = path;
+  VelodynePacketSource(std::unique_ptr<detail::DatagramFeed> feed, std::string format,
+                       const VelodyneSetup& setup)
+      : feed_(std::move(feed)), assembler_(make_velodyne_assembler(setup)) {
+    info_.format = std::move(format);
+    info_.path = feed_->origin();
     info_.sensor = setup.sensor;
     info_.sensor_from_metadata = true;
     info_.fields = velodyne_fields();
@@ -37,10 +38,10 @@ class VelodynePcapSource final : public ScanSource {
         return scan;
       }
       if (done_) return std::nullopt;
-      const std::optional<detail::UdpDatagram> datagram = reader_.next();
+      const std::optional<detail::UdpDatagram> datagram = feed_->next();
       if (!datagram) {
         done_ = true;
-        if (reader_.problem()) warn(*reader_.problem());
+        for (const std::string& warning : feed_->end_warnings()) warn(warning);
         if (assembler_.decoder().bad_blocks() > 0) {
           warn(std::to_string(assembler_.decoder().bad_blocks()) +
                " Velodyne data blocks with a flag or azimuth the model does not use; skipped");
@@ -57,8 +58,7 @@ class VelodynePcapSource final : public ScanSource {
 
  private:
   SourceInfo info_;
-  std::ifstream stream_;
-  detail::PcapUdpReader reader_;  // reads stream_, so it comes after it
+  std::unique_ptr<detail::DatagramFeed> feed_;
   VelodyneScanAssembler assembler_;
   bool done_ = false;
 };
@@ -91,8 +91,9 @@ std::unique_ptr<ScanSource> open_velodyne_pcap(const std::string& path,
                                                const SourceOptions& options) {
   const std::optional<std::vector<uint8_t>> first = first_velodyne_packet(path);
   if (!first) throw InputError(path + ": no Velodyne data packet (1206-byte UDP payload)");
-  return std::make_unique<VelodynePcapSource>(
-      path, velodyne_setup(first->data(), options, sensor_for, path));
+  return std::make_unique<VelodynePacketSource>(
+      std::make_unique<detail::PcapDatagramFeed>(path), "velodyne-pcap",
+      velodyne_setup(first->data(), options, sensor_for, path));
 }
 
 }  // namespace featsense::slam
