@@ -12,6 +12,7 @@
 #include "featsense/slam/io/ouster_frame_assembler.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "imu_sweep_assigner.hpp"
+#include "net/packet_sources.hpp"
 #include "net/pcap_datagram_feed.hpp"
 #include "ouster/ouster_imu_packet.hpp"
 
@@ -242,14 +243,30 @@ class OusterPacketSource final : public ScanSource {
 
 }  // namespace
 
+namespace detail {
+
+std::unique_ptr<ScanSource> ouster_packet_source(std::unique_ptr<DatagramFeed> feed,
+                                                 std::string format,
+                                                 const std::filesystem::path& meta_path,
+                                                 OusterMetadata metadata, bool read_imu,
+                                                 std::optional<int> imu_port) {
+  return std::make_unique<OusterPacketSource>(std::move(feed), std::move(format), meta_path,
+                                              std::move(metadata), read_imu, imu_port);
+}
+
+OusterMetadata read_ouster_metadata(const std::filesystem::path& path) {
+  return parse_ouster_metadata(read_text_file(path), path.string());
+}
+
+}  // namespace detail
+
 std::unique_ptr<ScanSource> open_ouster_pcap(const std::string& path,
                                              const SourceOptions& options) {
   // The metadata describes this very unit, so it wins over options.sensor_preset.
   const fs::path meta_path = options.meta_path ? fs::path(*options.meta_path) : find_metadata(path);
-  OusterMetadata metadata = parse_ouster_metadata(read_text_file(meta_path), meta_path.string());
-  return std::make_unique<OusterPacketSource>(std::make_unique<detail::PcapDatagramFeed>(path),
-                                              "ouster-pcap", meta_path, std::move(metadata),
-                                              options.imu);
+  return detail::ouster_packet_source(std::make_unique<detail::PcapDatagramFeed>(path),
+                                      "ouster-pcap", meta_path,
+                                      detail::read_ouster_metadata(meta_path), options.imu);
 }
 
 }  // namespace featsense::slam

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "featsense/slam/io/readers.hpp"
+#include "net/packet_sources.hpp"
 #include "net/pcap_datagram_feed.hpp"
 #include "ouster/pcap_udp_reader.hpp"
 #include "velodyne/velodyne_setup.hpp"
@@ -79,6 +80,12 @@ std::optional<std::vector<uint8_t>> first_velodyne_packet(const std::string& pat
 
 }  // namespace
 
+std::unique_ptr<ScanSource> detail::velodyne_packet_source(std::unique_ptr<DatagramFeed> feed,
+                                                           std::string format,
+                                                           const VelodyneSetup& setup) {
+  return std::make_unique<VelodynePacketSource>(std::move(feed), std::move(format), setup);
+}
+
 bool is_velodyne_pcap(const std::string& path) {
   try {
     return first_velodyne_packet(path).has_value();
@@ -91,9 +98,9 @@ std::unique_ptr<ScanSource> open_velodyne_pcap(const std::string& path,
                                                const SourceOptions& options) {
   const std::optional<std::vector<uint8_t>> first = first_velodyne_packet(path);
   if (!first) throw InputError(path + ": no Velodyne data packet (1206-byte UDP payload)");
-  return std::make_unique<VelodynePacketSource>(
-      std::make_unique<detail::PcapDatagramFeed>(path), "velodyne-pcap",
-      velodyne_setup(first->data(), options, sensor_for, path));
+  return detail::velodyne_packet_source(std::make_unique<detail::PcapDatagramFeed>(path),
+                                        "velodyne-pcap",
+                                        velodyne_setup(first->data(), options, sensor_for, path));
 }
 
 }  // namespace featsense::slam

@@ -1,0 +1,204 @@
+// Live input: datagrams sent over the loopback interface to a live source must give exactly
+// the scans its pcap reader gives for the same packets, and the receiver's limits (a full
+// buffer, silence, a stop, a port in use) must each end or warn as documented.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "common/test_data.hpp"
+#include "featsense/slam/io/live_source.hpp"
+#include "featsense/slam/io/readers.hpp"
+#include "net/udp_receiver.hpp"
+#include "ouster/pcap_udp_reader.hpp"
+#include "slam/udp_test_util.hpp"
+
+namespace featsense::slam {
+namespace {
+
+constexpr const char* kOs1Pcap = "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap";
+constexpr const char* kOs1Json = "ouster/OS-1-128_v2.3.0_1024x10.json";
+
+std::vector<Scan> all_scans(ScanSource& source) {
+  std::vector<Scan> scans;
+  while (std::optional<Scan> scan = source.next()) scans.push_back(std::move(*scan));
+  return scans;
+}
+
+detail::UdpListenSettings loopback(std::vector<int> ports) {
+  detail::UdpListenSettings s;
+  s.host = "127.0.0.1";
+  s.ports = std::move(ports);
+  s.idle_timeout_s = 0.5;
+  return s;
+}
+
+TEST(UdpReceiver, HandsOutDatagramsInOrderWithTheirPort) {
+  const int a = test::free_udp_port();
+  const int b = test::free_udp_port();
+  detail::UdpReceiver receiver(loopback({a, b}));
+  std::vector<test::Outgoing> out;
+  for (uint8_t i = 0; i < 20; ++i)
+    out.push_back({i % 2 == 0 ? a : b, std::vector<uint8_t>(100 + i, i)});
+  test::send_all(out, std::chrono::microseconds(200));
+  // In order per port (the receive thread empties one socket, then the other).
+  std::vector<uint8_t> on_a, on_b;
+  for (int i = 0; i < 20; ++i) {
+    const std::optional<detail::UdpDatagram> d = receiver.next();
+    ASSERT_TRUE(d);
+    EXPECT_EQ(d->size, 100u + d->payload[0]);
+    EXPECT_GT(d->timestamp_ns, 0);
+    (d->destination_port == a ? on_a : on_b).push_back(d->payload[0]);
+  }
+  EXPECT_EQ(on_a, std::vector<uint8_t>({0, 2, 4, 6, 8, 10, 12, 14, 16, 18}));
+  EXPECT_EQ(on_b, std::vector<uint8_t>({1, 3, 5, 7, 9, 11, 13, 15, 17, 19}));
+  // Then silence: the idle timeout ends the input, and says so.
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(receiver.next());
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(450));
+  ASSERT_TRUE(receiver.problem());
+  EXPECT_NE(receiver.problem()->find("no datagram for"), std::string::npos);
+  EXPECT_TRUE(receiver.end_warnings().empty());
+}
+
+TEST(UdpReceiver, AFullBufferDropsAndCountsInsteadOfGrowing) {
+  const int port = test::free_udp_port();
+  detail::UdpListenSettings settings = loopback({port});
+  settings.buffer_datagrams = 10;
+  detail::UdpReceiver receiver(settings);
+  std::vector<test::Outgoing> out(50, test::Outgoing{port, std::vector<uint8_t>(64, 7)});
+  test::send_all(out, std::chrono::microseconds(100));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // all received, none read
+  size_t read = 0;
+  while (receiver.next()) ++read;
+  EXPECT_EQ(read, 10u);
+  EXPECT_EQ(receiver.stats().received, 50u);
+  EXPECT_EQ(receiver.stats().dropped_full, 40u);
+  ASSERT_EQ(receiver.end_warnings().size(), 1u);
+  EXPECT_NE(receiver.end_warnings()[0].find("40 of 50 datagrams dropped"), std::string::npos)
+      << receiver.end_warnings()[0];
+}
+
+TEST(UdpReceiver, AStopEndsTheWaitWithoutADatagram) {
+  detail::UdpListenSettings settings = loopback({test::free_udp_port()});
+  settings.idle_timeout_s = 0.0;  // only the stop ends it
+  const auto start = std::chrono::steady_clock::now();
+  settings.stop_requested = [start] {
+    return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(300);
+  };
+  detail::UdpReceiver receiver(settings);
+  EXPECT_FALSE(receiver.next());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_EQ(receiver.problem(), std::optional<std::string>("stopped"));
+}
+
+TEST(UdpReceiver, APortInUseIsOneClearError) {
+  const int port = test::free_udp_port();
+  detail::UdpReceiver first(loopback({port}));
+  try {
+    detail::UdpReceiver second(loopback({port}));
+    FAIL() << "a second receiver bound the same port";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cannot listen on 127.0.0.1:" + std::to_string(port)), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("another program receives there"), std::string::npos) << what;
+  }
+  EXPECT_THROW(detail::UdpReceiver(loopback({70000})), InputError);
+  detail::UdpListenSettings bad_host = loopback({port});
+  bad_host.host = "not-an-address";
+  EXPECT_THROW(detail::UdpReceiver{bad_host}, InputError);
+}
+
+TEST(LiveSource, OusterWithoutMetadataIsAnError) {
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  try {
+    open_live_source(live, {});
+    FAIL() << "opened without metadata";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--meta FILE"), std::string::npos) << e.what();
+  }
+}
+
+TEST(LiveSource, OusterPacketsOverTheNetworkGiveThePcapsScans) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  SourceOptions options;
+  options.meta_path = json.string();
+  const std::vector<Scan> expected = all_scans(*open_ouster_pcap(pcap.string(), options));
+  ASSERT_EQ(expected.size(), 3u);
+
+  // The capture's datagrams, each to the live source's port for its kind.
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.imu_port = test::free_udp_port();
+  live.idle_timeout_s = 1.0;
+  std::vector<test::Outgoing> out;
+  std::ifstream stream(pcap, std::ios::binary);
+  detail::PcapUdpReader reader(stream, pcap.string());
+  while (const std::optional<detail::UdpDatagram> d = reader.next()) {
+    out.push_back({d->destination_port == 7503 ? *live.imu_port : *live.lidar_port,
+                   std::vector<uint8_t>(d->payload, d->payload + d->size)});
+  }
+  std::unique_ptr<ScanSource> source = open_live_source(live, options);
+  EXPECT_EQ(source->info().format, "ouster-live");
+  EXPECT_EQ(source->info().sensor.beams, 128);
+  std::thread sender(test::send_all, std::cref(out), std::chrono::microseconds(300));
+  const std::vector<Scan> got = all_scans(*source);
+  sender.join();
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t k = 0; k < got.size(); ++k) {
+    // The stamps are the sensor's, from the packets: the same as recorded.
+    EXPECT_EQ(got[k].stamp_ns, expected[k].stamp_ns);
+    EXPECT_EQ(got[k].valid, expected[k].valid);
+    EXPECT_EQ(got[k].xyz, expected[k].xyz);
+    EXPECT_EQ(got[k].time_offset_s, expected[k].time_offset_s);
+  }
+  EXPECT_EQ(source->stats().warning_count, 0u) << source->stats().warnings.front();
+}
+
+TEST(LiveSource, ASilentOusterEndsWithTheNoPacketsError) {
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  SourceOptions options;
+  options.meta_path = json.string();
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.imu_port = test::free_udp_port();
+  live.idle_timeout_s = 0.3;
+  std::unique_ptr<ScanSource> source = open_live_source(live, options);
+  try {
+    source->next();
+    FAIL() << "a scan from silence";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no lidar packets"), std::string::npos) << what;
+    EXPECT_NE(what.find("no datagram for"), std::string::npos) << what;
+  }
+}
+
+TEST(LiveSource, ASilentVelodyneIsOneClearError) {
+  LiveOptions live;
+  live.sensor = LiveSensor::kVelodyne;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.idle_timeout_s = 0.3;
+  try {
+    open_live_source(live, {});
+    FAIL() << "opened from silence";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no Velodyne data packet"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace featsense::slam
