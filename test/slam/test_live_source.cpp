@@ -14,6 +14,7 @@
 
 #include "common/test_data.hpp"
 #include "featsense/slam/io/live_source.hpp"
+#include "featsense/slam/io/pcap_replay.hpp"
 #include "featsense/slam/io/readers.hpp"
 #include "net/udp_receiver.hpp"
 #include "ouster/pcap_udp_reader.hpp"
@@ -152,7 +153,7 @@ TEST(LiveSource, OusterPacketsOverTheNetworkGiveThePcapsScans) {
   std::unique_ptr<ScanSource> source = open_live_source(live, options);
   EXPECT_EQ(source->info().format, "ouster-live");
   EXPECT_EQ(source->info().sensor.beams, 128);
-  std::thread sender(test::send_all, std::cref(out), std::chrono::microseconds(300));
+  std::thread sender(test::send_all, std::cref(out), std::chrono::microseconds(1350));
   const std::vector<Scan> got = all_scans(*source);
   sender.join();
   ASSERT_EQ(got.size(), expected.size());
@@ -198,6 +199,102 @@ TEST(LiveSource, ASilentVelodyneIsOneClearError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no Velodyne data packet"), std::string::npos) << e.what();
   }
+}
+
+/// Replays the OS1-128 capture into a live source on free ports and returns its scans.
+struct ReplayedOs1 {
+  std::vector<Scan> scans;
+  ReadStats stats;
+  ReplayResult replay;
+};
+
+ReplayedOs1 replay_os1(const std::filesystem::path& pcap, const std::filesystem::path& json,
+                       ReplaySettings settings) {
+  SourceOptions options;
+  options.meta_path = json.string();
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.imu_port = test::free_udp_port();
+  live.idle_timeout_s = 1.0;
+  std::unique_ptr<ScanSource> source = open_live_source(live, options);
+  settings.ports = {{7502, *live.lidar_port}, {7503, *live.imu_port}};
+  ReplayedOs1 out;
+  std::thread sender([&] { out.replay = replay_pcap(pcap.string(), settings); });
+  out.scans = all_scans(*source);
+  sender.join();
+  out.stats = source->stats();
+  return out;
+}
+
+TEST(PcapReplay, ReplayedToALiveSourceGivesThePcapsScans) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  SourceOptions options;
+  options.meta_path = json.string();
+  const std::vector<Scan> expected = all_scans(*open_ouster_pcap(pcap.string(), options));
+  // At the sensor's pace: a receive buffer of the kernel's default size (208 KB, 28 of these
+  // packets) must not overflow on a busy machine.
+  const ReplayedOs1 got = replay_os1(pcap, json, {});
+  EXPECT_EQ(got.replay.sent, 222u);  // every UDP datagram of the capture
+  EXPECT_EQ(got.replay.passes, 1u);
+  EXPECT_NEAR(got.replay.recording_seconds, 0.2985, 0.001);
+  EXPECT_GT(got.replay.seconds, 0.29);  // the recorded timing, not faster
+  EXPECT_LT(got.replay.seconds, 2.0);
+  ASSERT_EQ(got.scans.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(got.scans[k].stamp_ns, expected[k].stamp_ns);
+    EXPECT_EQ(got.scans[k].xyz, expected[k].xyz);
+  }
+}
+
+TEST(PcapReplay, DroppedDatagramsLeaveIncompleteFramesWithWarnings) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  ReplaySettings settings;
+  settings.drop_fraction = 0.2;
+  settings.seed = 7;
+  const ReplayedOs1 got = replay_os1(pcap, json, settings);
+  EXPECT_EQ(got.replay.sent + got.replay.dropped, 222u);
+  EXPECT_GT(got.replay.dropped, 20u);
+  EXPECT_LT(got.replay.dropped, 70u);
+  // The frames come, short of the dropped packets' columns, each with a warning.
+  ASSERT_GE(got.scans.size(), 2u);
+  EXPECT_GT(got.stats.warning_count, 0u);
+  for (const Scan& scan : got.scans) EXPECT_LT(scan.valid_count(), 107000u);
+  // The same seed drops the same datagrams.
+  const ReplayedOs1 again = replay_os1(pcap, json, settings);
+  EXPECT_EQ(again.replay.dropped, got.replay.dropped);
+}
+
+TEST(PcapReplay, SettingsOutOfRangeAndEmptyCapturesAreErrors) {
+  const auto dir = test::scratch_dir("pcap_replay");
+  const std::filesystem::path empty = dir / "empty.pcap";
+  {
+    // A pcap global header (little-endian, microseconds, Ethernet) and no record.
+    const uint8_t header[24] = {0xd4, 0xc3, 0xb2, 0xa1, 2, 0, 4, 0, 0, 0, 0, 0,
+                                0,    0,    0,    0,    0, 0, 4, 0, 1, 0, 0, 0};
+    std::ofstream(empty, std::ios::binary).write(reinterpret_cast<const char*>(header), 24);
+  }
+  try {
+    replay_pcap(empty.string(), {});
+    FAIL() << "replayed an empty capture";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no UDP datagram to replay"), std::string::npos)
+        << e.what();
+  }
+  ReplaySettings bad;
+  bad.rate = 0.0;
+  EXPECT_THROW(replay_pcap(empty.string(), bad), InputError);
+  bad = {};
+  bad.drop_fraction = 1.0;
+  EXPECT_THROW(replay_pcap(empty.string(), bad), InputError);
+  bad = {};
+  bad.host = "localhost";  // an address, not a name
+  EXPECT_THROW(replay_pcap(empty.string(), bad), InputError);
+  bad = {};
+  bad.ports = {{7502, 0}};
+  EXPECT_THROW(replay_pcap(empty.string(), bad), InputError);
 }
 
 }  // namespace
