@@ -158,11 +158,13 @@ mapping::MapperSettings mapper_settings(const slam::SourceInfo& info,
   settings.integrate = !options.poses_only;
   settings.reopen = reopen;
   settings.range = frame_range(options);
-  // The input's absolute path: a later session may map it again from elsewhere.
+  // The input's absolute path: a later session may map it again from elsewhere. An address
+  // (a live sensor's udp://...) stays as it is.
   std::error_code no_path;
-  const fs::path absolute_input = fs::absolute(info.path, no_path);
-  settings.session = {no_path ? info.path : absolute_input.lexically_normal().string(), info.format,
-                      "given poses"};
+  const bool address = info.path.find("://") != std::string::npos;
+  const fs::path absolute_input = address ? fs::path(info.path) : fs::absolute(info.path, no_path);
+  settings.session = {no_path || address ? info.path : absolute_input.lexically_normal().string(),
+                      info.format, "given poses"};
   if (poses) {
     settings.given_poses = std::move(poses);
     return settings;
@@ -193,8 +195,11 @@ void log_start(const slam::SourceInfo& info, const mapping::Mapper& mapper) {
 /// Runs the Mapper over `source` with Ctrl+C mapped onto its stop token. A recording that
 /// could not be placed in a saved map leaves a report.json that says why.
 mapping::MapResult run_mapper(slam::ScanSource& source, mapping::MapperSettings settings,
-                              const fs::path& out, const CliContext& context) {
-  const StopSignal stop_signal;
+                              const fs::path& out, const CliContext& context,
+                              const StopSignal* caller_signal) {
+  std::optional<StopSignal> own_signal;
+  if (caller_signal == nullptr) own_signal.emplace();
+  const StopSignal& stop_signal = caller_signal != nullptr ? *caller_signal : *own_signal;
   const mapping::RunEvents events = terminal_events(stop_signal.token(), context.quiet);
   try {
     mapping::Mapper mapper(std::move(settings), events);
@@ -278,13 +283,14 @@ std::optional<Eigen::Isometry3d> add_trajectory_evaluation(
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const std::optional<KnownTrajectory>& truth, const MapOptions& options,
                          config::Config config, const MeshReferences& references,
-                         const CliContext& context, const SourceReopener& reopen) {
+                         const CliContext& context, const SourceReopener& reopen,
+                         const StopSignal* stop_signal) {
   const slam::SourceInfo& info = source.info();
   const fs::path out(options.output);
   fs::create_directories(out);
   const mapping::MapResult result = run_mapper(
       source, mapper_settings(info, std::move(poses), truth, options, std::move(config), reopen),
-      out, context);
+      out, context, stop_signal);
   // With a continued map's voxel size and tau: the configuration the map keeps.
   const config::Config& used = result.config;
   const mapping::PassResult& mapped = result.mapped();
@@ -326,6 +332,14 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   return {out, report};
 }
 
+void add_map_output_flags(CLI::App& command, MapOptions& options) {
+  command.add_flag("--overwrite", options.overwrite, "Replace OUT/map.h5 if it exists");
+  command.add_flag("--no-mesh", options.no_mesh,
+                   "Write the map only, no mesh.ply / mesh.glb / topdown.png");
+  command.add_flag("--no-loop-closure", options.no_loop_closure,
+                   "Map with the odometry's poses alone (loop.enabled false)");
+}
+
 Command register_map(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<MapOptions>();
   CLI::App* command = app.add_subcommand(
@@ -351,12 +365,8 @@ Command register_map(CLI::App& app, const CliContext& context) {
   command->add_option("--start", options->start,
                       "First scan to map: a frame index, or seconds after the first scan (12.5s)");
   command->add_option("--end", options->end, "Last scan to map (as --start)");
-  command->add_flag("--overwrite", options->overwrite, "Replace OUT/map.h5 if it exists");
-  command->add_flag("--no-mesh", options->no_mesh,
-                    "Write the map only, no mesh.ply / mesh.glb / topdown.png");
+  add_map_output_flags(*command, *options);
   add_plan_height_option(*command, options->plan_height);
-  command->add_flag("--no-loop-closure", options->no_loop_closure,
-                    "Map with the odometry's poses alone (loop.enabled false)");
   command->add_flag("--poses-only", options->poses_only,
                     "Estimate the poses (odometry, refinement, loops) and write trajectory.tum "
                     "and the report only, no map: map later with --gt trajectory.tum");

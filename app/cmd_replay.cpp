@@ -97,7 +97,9 @@ Command register_replay(CLI::App& app, const CliContext& context) {
   command->add_option("--rate", options->settings.rate, "Speed against the recording (2: twice)")
       ->check(CLI::Range(1e-3, 1000.0))
       ->capture_default_str();
-  command->add_flag("--loop", options->settings.loop, "Start over at the end, until Ctrl+C");
+  command->add_flag("--loop", options->settings.loop,
+                    "Start over at the end, until Ctrl+C (the packets keep their timestamps: "
+                    "the sensor's clock goes back at each start)");
   command
       ->add_option("--drop", options->settings.drop_fraction,
                    "Drop this share of the datagrams at random, to try a lossy network")

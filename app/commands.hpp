@@ -44,6 +44,8 @@ Command register_mesh(CLI::App& app, const CliContext& context);
 Command register_report(CLI::App& app, const CliContext& context);
 /// `featsense navmesh MESH -o NAV`: traversability layers for mesh-based navigation.
 Command register_navmesh(CLI::App& app, const CliContext& context);
+/// `featsense live --sensor ouster|velodyne -o OUT ...`: maps a sensor on the network.
+Command register_live(CLI::App& app, const CliContext& context);
 /// `featsense replay REC.pcap [--to ADDR] [--rate R] ...`: a recording sent as the sensor did.
 Command register_replay(CLI::App& app, const CliContext& context);
 /// `featsense view OUT [--port N]`: the output folder in the browser, until Ctrl+C.

@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
                                                    featsense::app::register_mesh(app, context),
                                                    featsense::app::register_report(app, context),
                                                    featsense::app::register_view(app, context),
-                                                   featsense::app::register_replay(app, context)};
+                                                   featsense::app::register_replay(app, context),
+                                                   featsense::app::register_live(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
   for (auto& command : featsense::app::register_bench(app, context)) commands.push_back(command);
   commands.push_back(featsense::app::register_bench_store(*app.get_subcommand("bench"), context));

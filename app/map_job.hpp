@@ -15,6 +15,7 @@
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "map_outputs.hpp"
 #include "source_options.hpp"
+#include "stop_signal.hpp"
 
 namespace featsense::app {
 
@@ -44,6 +45,9 @@ struct MapOutcome {
   nlohmann::json report;  ///< as written to report.json
 };
 
+/// Adds --overwrite, --no-mesh and --no-loop-closure (MapOptions') to `command`.
+void add_map_output_flags(CLI::App& command, MapOptions& options);
+
 /// The true path where it is known, for the report's eval.traj (SE(3)-aligned, as `featsense
 /// eval traj`). A simulation's starts at the first scan: estimated poses then start there too,
 /// so that the map lies in the frame of the true surface and compares with it unaligned.
@@ -66,11 +70,14 @@ using SourceReopener = mapping::SourceReopener;
 
 /// Maps `source` with `poses` (given poses; nullopt: estimated by the odometry front end) and
 /// `config` (from map_config) into OUT (map.h5, trajectory.tum/.kitti, mesh.ply/.glb,
-/// report.json), comparing the path with `truth` where given. Throws ConfigError,
-/// InputError, Interrupted (after writing the outputs) or std::runtime_error.
+/// report.json), comparing the path with `truth` where given. Ctrl+C stops it through
+/// `stop_signal` where given (one the caller installed, that its source also heeds), else
+/// through one of its own. Throws ConfigError, InputError, Interrupted (after writing the
+/// outputs) or std::runtime_error.
 MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajectory> poses,
                          const std::optional<KnownTrajectory>& truth, const MapOptions& options,
                          config::Config config, const MeshReferences& references,
-                         const CliContext& context, const SourceReopener& reopen = {});
+                         const CliContext& context, const SourceReopener& reopen = {},
+                         const StopSignal* stop_signal = nullptr);
 
 }  // namespace featsense::app

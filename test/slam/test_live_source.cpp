@@ -134,7 +134,7 @@ TEST(LiveSource, OusterPacketsOverTheNetworkGiveThePcapsScans) {
   FEATSENSE_SHARED_FILE(json, kOs1Json);
   SourceOptions options;
   options.meta_path = json.string();
-  const std::vector<Scan> expected = all_scans(*open_ouster_pcap(pcap.string(), options));
+  const std::vector<Scan> expected = all_scans(*open_scan_source(pcap.string(), options));
   ASSERT_EQ(expected.size(), 3u);
 
   // The capture's datagrams, each to the live source's port for its kind.
@@ -232,7 +232,7 @@ TEST(PcapReplay, ReplayedToALiveSourceGivesThePcapsScans) {
   FEATSENSE_SHARED_FILE(json, kOs1Json);
   SourceOptions options;
   options.meta_path = json.string();
-  const std::vector<Scan> expected = all_scans(*open_ouster_pcap(pcap.string(), options));
+  const std::vector<Scan> expected = all_scans(*open_scan_source(pcap.string(), options));
   // At the sensor's pace: a receive buffer of the kernel's default size (208 KB, 28 of these
   // packets) must not overflow on a busy machine.
   const ReplayedOs1 got = replay_os1(pcap, json, {});

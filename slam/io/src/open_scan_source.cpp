@@ -130,7 +130,11 @@ std::unique_ptr<ScanSource> open_by_content(const std::string& input,
 
 std::unique_ptr<ScanSource> open_scan_source(const std::string& input,
                                              const SourceOptions& options) {
-  std::unique_ptr<ScanSource> source = open_by_content(input, options);
+  return with_range_limits(open_by_content(input, options), options);
+}
+
+std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source,
+                                              const SourceOptions& options) {
   const config::SensorModel& sensor = source->info().sensor;
   const double min_m = options.min_range_m.value_or(sensor.min_range_m);
   const double max_m =

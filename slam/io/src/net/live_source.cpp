@@ -90,23 +90,9 @@ std::unique_ptr<ScanSource> open_velodyne_live(const LiveOptions& live,
 
 std::unique_ptr<ScanSource> open_live_source(const LiveOptions& live,
                                              const SourceOptions& options) {
-  return live.sensor == LiveSensor::kOuster ? open_ouster_live(live, options)
-                                            : open_velodyne_live(live, options);
-}
-
-std::string live_address(const LiveOptions& live, const SourceOptions& options) {
-  if (live.sensor == LiveSensor::kVelodyne) {
-    return "udp://" + live.host + ":" + std::to_string(live.lidar_port.value_or(kVelodyneDataPort));
-  }
-  int lidar = live.lidar_port.value_or(7502);
-  int imu = live.imu_port.value_or(7503);
-  if (options.meta_path && (!live.lidar_port || !live.imu_port)) {
-    const OusterMetadata metadata = detail::read_ouster_metadata(*options.meta_path);
-    lidar = live.lidar_port.value_or(metadata.udp_port_lidar);
-    imu = live.imu_port.value_or(metadata.udp_port_imu);
-  }
-  return "udp://" + live.host + ":" + std::to_string(lidar) +
-         (options.imu ? "," + std::to_string(imu) : "");
+  return with_range_limits(live.sensor == LiveSensor::kOuster ? open_ouster_live(live, options)
+                                                              : open_velodyne_live(live, options),
+                           options);
 }
 
 }  // namespace featsense::slam

@@ -38,9 +38,7 @@ struct LiveOptions {
 /// first data packet (next() waits for it), the calibration and scan cut as for a pcap.
 /// Throws InputError where a port cannot be listened on or the metadata cannot be read; a
 /// sensor that sends nothing before the idle timeout ends with the readers' "no packets" error.
+/// The scans have the range limits of open_scan_source().
 std::unique_ptr<ScanSource> open_live_source(const LiveOptions& live, const SourceOptions& options);
-
-/// The ports a live source listens on for `live` (lidar first), the defaults filled in.
-std::string live_address(const LiveOptions& live, const SourceOptions& options);
 
 }  // namespace featsense::slam

@@ -45,6 +45,10 @@ std::unique_ptr<ScanSource> with_range_limits(
     std::unique_ptr<ScanSource> source, double min_m, double max_m,
     const std::optional<std::array<double, 6>>& self_box = std::nullopt);
 
+/// Wraps `source` with the range limits and self box of `options` (else the sensor's limits).
+std::unique_ptr<ScanSource> with_range_limits(std::unique_ptr<ScanSource> source,
+                                              const SourceOptions& options);
+
 /// Opens a recording, detecting its format from the content: an Ouster pcap, a ROS1 bag, a
 /// ROS 2 bag (a folder holding metadata.yaml, or one .db3), an MCAP file, a PCD or PLY
 /// file, or a folder of KITTI .bin / PCD / PLY scans or of `featsense simulate`.

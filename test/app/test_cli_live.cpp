@@ -1,0 +1,168 @@
+// featsense live and replay, end to end: a recording replayed over the loopback interface to
+// a live run gives the map run's poses; a live run ends on silence or Ctrl+C with its outputs
+// written; the errors a user meets (no metadata, a port in use) are one clear message each.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "common/json_file.hpp"
+#include "common/run_command.hpp"
+#include "common/spawn_command.hpp"
+#include "common/test_data.hpp"
+#include "slam/udp_test_util.hpp"
+
+namespace featsense::test {
+namespace {
+
+constexpr const char* kOs1Pcap = "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap";
+constexpr const char* kOs1Json = "ouster/OS-1-128_v2.3.0_1024x10.json";
+
+std::string text_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Waits until `log` contains `what` (false: the child ended first, or 30 s passed).
+bool wait_for_line(const std::filesystem::path& log, const std::string& what, pid_t child) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < end) {
+    if (text_of(log).find(what) != std::string::npos) return true;
+    int status = 0;
+    if (waitpid(child, &status, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+int wait_exit_code(pid_t child) {
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(CliLive, AReplayedRecordingMapsAsTheRecordingDoes) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  const auto dir = scratch_dir("cli_live_replay");
+  const int lidar = free_udp_port();
+  const int imu = free_udp_port();
+  const std::filesystem::path log = dir / "live.log";
+  const pid_t live = spawn_featsense(
+      "live --sensor ouster --meta " + json.string() + " --host 127.0.0.1 --lidar-port " +
+          std::to_string(lidar) + " --imu-port " + std::to_string(imu) +
+          " --idle-timeout 2 --no-mesh -o " + (dir / "live").string(),
+      log);
+  ASSERT_TRUE(wait_for_line(log, "listening on udp://127.0.0.1:", live)) << text_of(log);
+  const CommandResult replay = run_featsense(
+      "replay " + pcap.string() + " --port 7502:" + std::to_string(lidar) +
+      " --port 7503:" + std::to_string(imu) + " --json " + (dir / "replay.json").string());
+  EXPECT_EQ(replay.exit_code, 0) << replay.output;
+  EXPECT_EQ(wait_exit_code(live), 0) << text_of(log);
+  EXPECT_NE(text_of(log).find("3 scans mapped"), std::string::npos) << text_of(log);
+  const nlohmann::json sent = read_json(dir / "replay.json");
+  EXPECT_EQ(sent["sent"], 222);
+  EXPECT_EQ(sent["failed"], 0);
+
+  const CommandResult map =
+      run_featsense("map " + pcap.string() + " --no-mesh --quiet -o " + (dir / "map").string());
+  ASSERT_EQ(map.exit_code, 0) << map.output;
+  EXPECT_EQ(text_of(dir / "live" / "trajectory.tum"), text_of(dir / "map" / "trajectory.tum"));
+  const nlohmann::json report = read_json(dir / "live" / "report.json");
+  EXPECT_EQ(report["input"]["format"], "ouster-live");
+  EXPECT_EQ(report["input"]["path"],
+            "udp://127.0.0.1:" + std::to_string(lidar) + "," + std::to_string(imu));
+  EXPECT_EQ(report["frames"], 3);
+}
+
+TEST(CliLive, CtrlCWhileMappingWritesTheMapAndExitsCleanly) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  const auto dir = scratch_dir("cli_live_ctrl_c_mapping");
+  const int lidar = free_udp_port();
+  const int imu = free_udp_port();
+  const pid_t live = spawn_featsense(
+      "live --sensor ouster --meta " + json.string() + " --host 127.0.0.1 --lidar-port " +
+          std::to_string(lidar) + " --imu-port " + std::to_string(imu) +
+          " --no-mesh --set map.flush_interval=1 -o " + (dir / "live").string(),
+      dir / "live.log");
+  ASSERT_TRUE(wait_for_line(dir / "live.log", "listening on", live)) << text_of(dir / "live.log");
+  const CommandResult replay =
+      run_featsense("replay " + pcap.string() + " --quiet --port 7502:" + std::to_string(lidar) +
+                    " --port 7503:" + std::to_string(imu));
+  EXPECT_EQ(replay.exit_code, 0) << replay.output;
+  // The three scans are mapped and flushed (every second here); the sensor then falls silent.
+  const bool flushed = wait_for_first_flush(dir / "live" / "map.h5.journal", live);
+  kill(live, SIGINT);
+  const int live_exit = wait_exit_code(live);
+  ASSERT_TRUE(flushed) << text_of(dir / "live.log");
+  // Ctrl+C is how a live run ends: exit 0, the map, the poses and the report written.
+  EXPECT_EQ(live_exit, 0) << text_of(dir / "live.log");
+  EXPECT_NE(text_of(dir / "live.log").find("stopped: the map"), std::string::npos)
+      << text_of(dir / "live.log");
+  const nlohmann::json report = read_json(dir / "live" / "report.json");
+  EXPECT_EQ(report["frames"], 3);
+  EXPECT_TRUE(std::filesystem::exists(dir / "live" / "trajectory.tum"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "live" / "map.h5"));
+}
+
+TEST(CliLive, CtrlCEndsAWaitWithOneClearMessage) {
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  const auto dir = scratch_dir("cli_live_ctrl_c");
+  const std::filesystem::path log = dir / "live.log";
+  const pid_t live = spawn_featsense(
+      "live --sensor ouster --meta " + json.string() + " --host 127.0.0.1 --lidar-port " +
+          std::to_string(free_udp_port()) + " --imu-port " + std::to_string(free_udp_port()) +
+          " -o " + (dir / "live").string(),
+      log);
+  ASSERT_TRUE(wait_for_line(log, "listening on", live)) << text_of(log);
+  kill(live, SIGINT);
+  // Nothing was sent: no scan, said so, not a hang.
+  EXPECT_NE(wait_exit_code(live), 0);
+  EXPECT_NE(text_of(log).find("no scan came before the stop"), std::string::npos) << text_of(log);
+}
+
+TEST(CliLive, BadSetupsAreOneClearError) {
+  const auto dir = scratch_dir("cli_live_errors");
+  const CommandResult no_meta =
+      run_featsense("live --sensor ouster --host 127.0.0.1 --lidar-port " +
+                    std::to_string(free_udp_port()) + " -o " + (dir / "a").string());
+  EXPECT_NE(no_meta.exit_code, 0);
+  EXPECT_NE(no_meta.output.find("--meta FILE"), std::string::npos) << no_meta.output;
+
+  // A port another program holds.
+  const int port = free_udp_port();
+  const int holder = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(holder, reinterpret_cast<const sockaddr*>(&address), sizeof address), 0);
+  const CommandResult in_use =
+      run_featsense("live --sensor velodyne --host 127.0.0.1 --lidar-port " + std::to_string(port) +
+                    " -o " + (dir / "b").string());
+  ::close(holder);
+  EXPECT_NE(in_use.exit_code, 0);
+  EXPECT_NE(in_use.output.find("cannot listen on 127.0.0.1:" + std::to_string(port)),
+            std::string::npos)
+      << in_use.output;
+
+  const CommandResult bad_sensor = run_featsense("live --sensor hesai -o " + (dir / "c").string());
+  EXPECT_NE(bad_sensor.exit_code, 0);
+  const CommandResult bad_rate = run_featsense("replay /dev/null --rate 0");
+  EXPECT_NE(bad_rate.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace featsense::test
