@@ -42,7 +42,11 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
                        {"shift", timing_json(run.timings.shift_ms)},
                        {"integrate", timing_json(run.timings.integrate_ms)},
                        {"flush", timing_json(run.timings.flush_ms)},
-                       {"final_flush", timing_json(run.timings.final_flush_ms)}};
+                       {"final_flush", timing_json(run.timings.final_flush_ms)},
+                       {"latency",
+                        {{"pose", timing_json(run.timings.latency_pose_ms)},
+                         {"final_pose", timing_json(run.timings.latency_final_pose_ms)},
+                         {"integrated", timing_json(run.timings.latency_integrated_ms)}}}};
   report["wall_s"] = run.wall_s;
   report["scans_per_s"] = run.scans_per_s();
   report["recording_s"] = run.recording_s;

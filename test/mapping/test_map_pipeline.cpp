@@ -6,8 +6,10 @@
 #include <tbb/global_control.h>
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <stdexcept>
+#include <thread>
 
 #include "common/test_data.hpp"
 #include "featsense/mapping/map_pipeline.hpp"
@@ -73,6 +75,45 @@ class FailingLocator : public slam::ScanLocator {
   std::unique_ptr<slam::ScanLocator> inner_;
   uint64_t fail_at_;
 };
+
+/// A locator that places scans as the true path does, taking `delay` over each.
+class SlowLocator : public slam::ScanLocator {
+ public:
+  SlowLocator(slam::Trajectory path, std::chrono::milliseconds delay)
+      : inner_(slam::make_given_pose_locator(std::move(path), true)), delay_(delay) {}
+  std::optional<slam::ScanPlacement> locate(const slam::Scan& scan, std::string& why) override {
+    std::this_thread::sleep_for(delay_);
+    return inner_->locate(scan, why);
+  }
+  std::string description() const override { return "slow"; }
+
+ private:
+  std::unique_ptr<slam::ScanLocator> inner_;
+  std::chrono::milliseconds delay_;
+};
+
+TEST(MapPipeline, EachScansLatencyIsMeasuredFromItsSourceToTheMap) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_latency");
+  const slam::BoxRoomSettings room = small_room(8);
+  config::Config config = test::small_map_config();
+  SlowLocator locator(test::room_path(room), std::chrono::milliseconds(30));
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  MapPass pass(locator, PassSettings{}, config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, {});
+  const PassResult result = run_pipeline(*source, pass);
+  const StageTimings& t = result.timings;
+  ASSERT_EQ(result.frames_mapped, 8u);
+  // One figure per scan mapped, at each stage, in the order the scans were mapped.
+  ASSERT_EQ(t.latency_pose_ms.size(), 8u);
+  ASSERT_EQ(t.latency_final_pose_ms.size(), 8u);
+  ASSERT_EQ(t.latency_integrated_ms.size(), 8u);
+  for (size_t k = 0; k < 8; ++k) {
+    // The front end took 30 ms over each; a scan waits for the ones before it as well.
+    EXPECT_GE(t.latency_pose_ms[k], 29.0) << k;
+    EXPECT_GE(t.latency_final_pose_ms[k], t.latency_pose_ms[k]) << k;
+    EXPECT_GE(t.latency_integrated_ms[k], t.latency_final_pose_ms[k]) << k;
+  }
+}
 
 TEST(MapPipeline, MakesTheSameMapAsAddingTheScansOneByOne) {
   const std::filesystem::path dir = test::scratch_dir("pipeline_same_map");

@@ -82,10 +82,12 @@ void MapPass::warn(const std::string& message) {
 
 std::optional<PlacedScan> MapPass::locate(slam::Scan scan, std::string* why_out) {
   const Clock::time_point start = Clock::now();
+  latency_.ready(scan.sequence);  // kept where the reader marked it already
   if (settings_.drop_mixed_pixels) result_.mixed_pixels_dropped += slam::drop_mixed_pixels(scan);
   std::string why;
   std::optional<slam::ScanPlacement> placement = locator_.locate(scan, why);
   if (!placement) {
+    latency_.since_ready(scan.sequence, true);
     ++result_.frames_without_pose;
     warn("skipped: " + why);
     if (why_out) *why_out = why;
@@ -96,6 +98,9 @@ std::optional<PlacedScan> MapPass::locate(slam::Scan scan, std::string* why_out)
   if (!why.empty()) warn(why);
   if (why_out) *why_out = why;
   result_.timings.locate_ms.push_back(ms_since(start));
+  if (const std::optional<double> ms = latency_.since_ready(scan.sequence)) {
+    result_.timings.latency_pose_ms.push_back(*ms);
+  }
   return PlacedScan{std::move(scan), std::move(*placement)};
 }
 
@@ -139,6 +144,10 @@ std::vector<PlacedScan> MapPass::finish_refinement() {
 
 std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed) {
   const Clock::time_point start = Clock::now();
+  if (const std::optional<double> ms =
+          latency_.since_ready(placed.placement.sequence, !settings_.integrate)) {
+    result_.timings.latency_final_pose_ms.push_back(*ms);
+  }
   if (loops_ && !loops_->offer(placed.scan, placed.placement)) return std::nullopt;
   if (loops_) result_.scan_motions.add(placed.scan, placed.placement);
   LocatedScan located;
@@ -175,6 +184,9 @@ void MapPass::integrate(LocatedScan scan) {
   result_.timings.integrate_ms.push_back(ms_since(start));
   result_.points += scan.rays.size();
   result_.voxels_updated += stats.voxels_updated;
+  if (const std::optional<double> ms = latency_.since_ready(scan.placement.sequence, true)) {
+    result_.timings.latency_integrated_ms.push_back(*ms);
+  }
   result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
   ++result_.frames_mapped;
 

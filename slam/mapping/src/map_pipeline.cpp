@@ -77,6 +77,7 @@ void read_scans(slam::ScanSource& source, const FrameRange& range, MapPass& pass
       continue;
     }
     pass.add_read_time(ms_since(start));
+    pass.mark_ready(scan->sequence);
     if (!out.push(std::move(*scan))) break;
   }
 }

@@ -21,6 +21,7 @@
 #include "featsense/mapping/map_sessions.hpp"
 #include "featsense/mapping/pass_result.hpp"
 #include "featsense/mapping/run_events.hpp"
+#include "featsense/mapping/scan_latency.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/refine/placement_refiner.hpp"
 #include "featsense/slam/scan.hpp"
@@ -90,6 +91,9 @@ class MapPass {
   void count_read() { frames_read_.fetch_add(1); }
   void count_before_range() { ++result_.frames_outside_range; }
   void add_read_time(double read_ms) { result_.timings.read_ms.push_back(read_ms); }
+  /// Scan `sequence` was handed out now: its latencies count from here (a scan given to
+  /// locate() without this counts from that call).
+  void mark_ready(uint64_t sequence) { latency_.ready(sequence); }
   /// Whether the pass holds scans for a refinement (the pipeline gives it a thread).
   bool refines() const { return refiner_ != nullptr; }
   /// The recording's scans, where known: for the progress only.
@@ -141,6 +145,7 @@ class MapPass {
   PassResult result_;
   std::mutex warnings_mutex_;
   std::atomic<size_t> frames_read_{0};
+  ScanLatency latency_;
   std::unique_ptr<slam::refine::PlacementRefiner> refiner_;
   std::deque<PlacedScan> held_;  ///< scans waiting for their final pose, in order
   bool refinement_finished_ = false;

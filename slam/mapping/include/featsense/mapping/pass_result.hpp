@@ -26,6 +26,12 @@ struct StageTimings {
   std::vector<double> flush_ms;
   std::vector<double> final_flush_ms;
   double loops_finish_ms = 0.0;  ///< after the last scan: the keyframes left, the last solve
+  /// Per scan, from when its source handed it out (a live sensor: about its last packet) to
+  /// its pose from the front end, its final pose (after the refinement: the loop closure and
+  /// the rays see it) and its integration into the map.
+  std::vector<double> latency_pose_ms;
+  std::vector<double> latency_final_pose_ms;
+  std::vector<double> latency_integrated_ms;
 };
 
 struct PassResult {
