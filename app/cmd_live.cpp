@@ -2,6 +2,8 @@
 // everything `featsense map` writes.
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -10,6 +12,7 @@
 #include "featsense/mapping/recording.hpp"
 #include "featsense/slam/io/live_source.hpp"
 #include "map_job.hpp"
+#include "ouster_metadata_fetch.hpp"
 #include "stop_signal.hpp"
 
 namespace featsense::app {
@@ -19,8 +22,25 @@ struct LiveCommandOptions {
   std::string sensor;
   slam::LiveOptions live;
   std::optional<std::string> meta_path;
+  std::optional<std::string> sensor_address;  ///< Ouster: where to fetch the metadata from
   MapOptions map;
 };
+
+/// The Ouster metadata's file: --meta, else the sensor's answer saved into the output folder
+/// (kept there: the record of the sensor the map was made with).
+std::optional<std::string> metadata_path(const LiveCommandOptions& options) {
+  if (options.meta_path || !options.sensor_address || options.sensor != "ouster") {
+    return options.meta_path;
+  }
+  const std::string json = fetch_ouster_metadata(*options.sensor_address);
+  const std::filesystem::path out(options.map.output);
+  std::filesystem::create_directories(out);
+  const std::filesystem::path path = out / "sensor_metadata.json";
+  std::ofstream file(path, std::ios::binary);
+  file << json;
+  if (!file) throw slam::InputError(path.string() + ": cannot write the sensor's metadata");
+  return path.string();
+}
 
 void run_live(LiveCommandOptions& options, const CliContext& context) {
   options.live.sensor =
@@ -34,7 +54,7 @@ void run_live(LiveCommandOptions& options, const CliContext& context) {
     std::fflush(stdout);
   };
   std::unique_ptr<slam::ScanSource> source = slam::open_live_source(
-      options.live, mapping::source_options(config, options.meta_path, std::nullopt));
+      options.live, mapping::source_options(config, metadata_path(options), std::nullopt));
   // No second pass after loop closures: what the sensor sent cannot be read again.
   try {
     map_recording(*source, std::nullopt, std::nullopt, options.map, config, {}, context, {},
@@ -76,6 +96,9 @@ Command register_live(CLI::App& app, const CliContext& context) {
                    "Ouster: the sensor's metadata JSON (as the sensor's HTTP API serves it at "
                    "/api/v1/sensor/metadata, or a recording's)")
       ->check(CLI::ExistingFile);
+  command->add_option("--sensor-address", options->sensor_address,
+                      "Ouster without --meta: the sensor's address (host or host:port); its "
+                      "metadata is fetched from its HTTP API and kept as OUT/sensor_metadata.json");
   command
       ->add_option("--host", options->live.host,
                    "Local IPv4 address to listen on (0.0.0.0: every interface)")

@@ -3,6 +3,7 @@
 // written; the errors a user meets (no metadata, a port in use) are one clear message each.
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -131,6 +132,79 @@ TEST(CliLive, CtrlCEndsAWaitWithOneClearMessage) {
   // Nothing was sent: no scan, said so, not a hang.
   EXPECT_NE(wait_exit_code(live), 0);
   EXPECT_NE(text_of(log).find("no scan came before the stop"), std::string::npos) << text_of(log);
+}
+
+/// A stub of an Ouster sensor's HTTP API on a free port of 127.0.0.1, answering
+/// /api/v1/sensor/metadata with `status` and `body`.
+class SensorApiStub {
+ public:
+  SensorApiStub(int status, std::string body) {
+    server_.Get("/api/v1/sensor/metadata",
+                [status, body](const httplib::Request&, httplib::Response& response) {
+                  response.status = status;
+                  response.set_content(body, "application/json");
+                });
+    port_ = server_.bind_to_any_port("127.0.0.1");
+    // Bound already: a client that connects before listen() starts waits in the backlog.
+    thread_ = std::thread([this] { server_.listen_after_bind(); });
+  }
+  ~SensorApiStub() {
+    server_.stop();
+    thread_.join();
+  }
+  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+
+ private:
+  httplib::Server server_;
+  int port_ = 0;
+  std::thread thread_;
+};
+
+TEST(CliLive, TheMetadataComesFromTheSensorsHttpApiAndIsKept) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  const SensorApiStub sensor(200, text_of(json));
+  const auto dir = scratch_dir("cli_live_metadata_fetch");
+  const int lidar = free_udp_port();
+  const std::filesystem::path log = dir / "live.log";
+  const pid_t live = spawn_featsense("live --sensor ouster --sensor-address " + sensor.address() +
+                                         " --host 127.0.0.1 --lidar-port " + std::to_string(lidar) +
+                                         " --imu-port " + std::to_string(free_udp_port()) +
+                                         " --idle-timeout 1 --no-mesh --no-loop-closure -o " +
+                                         (dir / "live").string(),
+                                     log);
+  ASSERT_TRUE(wait_for_line(log, "listening on", live)) << text_of(log);
+  const CommandResult replay =
+      run_featsense("replay " + pcap.string() + " --quiet --port 7502:" + std::to_string(lidar));
+  EXPECT_EQ(replay.exit_code, 0) << replay.output;
+  EXPECT_EQ(wait_exit_code(live), 0) << text_of(log);
+  EXPECT_EQ(text_of(dir / "live" / "sensor_metadata.json"), text_of(json));
+  EXPECT_EQ(read_json(dir / "live" / "report.json")["frames"], 3);
+}
+
+TEST(CliLive, ASensorApiThatFailsIsOneClearError) {
+  const auto dir = scratch_dir("cli_live_metadata_errors");
+  const auto live_with = [&](const std::string& address) {
+    return run_featsense("live --sensor ouster --sensor-address " + address +
+                         " --host 127.0.0.1 --lidar-port " + std::to_string(free_udp_port()) +
+                         " -o " + (dir / "out").string());
+  };
+  {
+    const SensorApiStub old_firmware(404, "not found");
+    const CommandResult r = live_with(old_firmware.address());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("HTTP status 404"), std::string::npos) << r.output;
+  }
+  {
+    const SensorApiStub garbled(200, "<html>");
+    const CommandResult r = live_with(garbled.address());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("not a JSON object"), std::string::npos) << r.output;
+  }
+  // Nobody there: a free port on this machine refuses the connection.
+  const CommandResult nobody = live_with("127.0.0.1:" + std::to_string(free_udp_port()));
+  EXPECT_NE(nobody.exit_code, 0);
+  EXPECT_NE(nobody.output.find("no answer"), std::string::npos) << nobody.output;
 }
 
 TEST(CliLive, BadSetupsAreOneClearError) {

@@ -52,8 +52,8 @@ std::unique_ptr<ScanSource> open_ouster_live(const LiveOptions& live,
                                              const SourceOptions& options) {
   if (!options.meta_path) {
     throw InputError("udp://" + live.host +
-                     ": a live Ouster sensor needs its metadata JSON (--meta FILE): the packets "
-                     "do not say the beams' angles");
+                     ": a live Ouster sensor needs its metadata JSON (--meta FILE, or the sensor's "
+                     "address to fetch it from): the packets do not say the beams' angles");
   }
   OusterMetadata metadata = detail::read_ouster_metadata(*options.meta_path);
   const int lidar_port = live.lidar_port.value_or(metadata.udp_port_lidar);
