@@ -53,7 +53,10 @@ inline nlohmann::json to_nested_layout(const nlohmann::json& flat) {
   if (flat["data_format"].contains("udp_profile_lidar")) {
     doc["config_params"]["udp_profile_lidar"] = flat["data_format"]["udp_profile_lidar"];
   }
-  doc["sensor_info"] = {{"prod_line", flat["prod_line"]}, {"prod_sn", "0"}};
+  doc["sensor_info"] = {{"prod_line", flat["prod_line"]}};
+  for (const char* key : {"prod_sn", "initialization_id"}) {
+    if (flat.contains(key)) doc["sensor_info"][key] = flat[key];
+  }
   return doc;
 }
 

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "common/test_data.hpp"
 #include "featsense/slam/io/live_source.hpp"
 #include "featsense/slam/io/pcap_replay.hpp"
@@ -165,6 +167,78 @@ TEST(LiveSource, OusterPacketsOverTheNetworkGiveThePcapsScans) {
     EXPECT_EQ(got[k].time_offset_s, expected[k].time_offset_s);
   }
   EXPECT_EQ(source->stats().warning_count, 0u) << source->stats().warnings.front();
+}
+
+/// The OS1-128 metadata with `key` set to `value`, written into the test's folder.
+std::filesystem::path os1_metadata_with(const std::filesystem::path& json, const std::string& key,
+                                        const nlohmann::json& value, const std::string& name) {
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(json));
+  doc[key] = value;
+  const std::filesystem::path path = test::scratch_dir(name) / "meta.json";
+  std::ofstream(path) << doc.dump();
+  return path;
+}
+
+TEST(LiveSource, AnotherSensorsPacketsOnThePortAreSkippedAndCounted) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  SourceOptions options;
+  options.meta_path = json.string();
+  const std::vector<Scan> expected = all_scans(*open_scan_source(pcap.string(), options));
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.imu_port = test::free_udp_port();
+  live.idle_timeout_s = 1.0;
+  // Every lidar packet twice: as recorded, and as a second unit (serial + 1) would send it.
+  std::vector<test::Outgoing> out;
+  std::ifstream stream(pcap, std::ios::binary);
+  detail::PcapUdpReader reader(stream, pcap.string());
+  while (const std::optional<detail::UdpDatagram> d = reader.next()) {
+    std::vector<uint8_t> bytes(d->payload, d->payload + d->size);
+    out.push_back({*live.lidar_port, bytes});
+    if (d->size == 8448) {
+      ++bytes[7];  // the serial's lowest byte (PACKET_FORMAT.md)
+      out.push_back({*live.lidar_port, bytes});
+    }
+  }
+  std::unique_ptr<ScanSource> source = open_live_source(live, options);
+  std::thread sender(test::send_all, std::cref(out), std::chrono::microseconds(700));
+  const std::vector<Scan> got = all_scans(*source);
+  sender.join();
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].xyz, expected[k].xyz);
+  ASSERT_EQ(source->stats().warning_count, 1u);
+  EXPECT_NE(source->stats().warnings[0].find("192 lidar packets from another sensor (serial "
+                                             "122201000999) than the metadata's (serial "
+                                             "122201000998"),
+            std::string::npos)
+      << source->stats().warnings[0];
+}
+
+TEST(LiveSource, MetadataOfAnotherUnitIsOneClearError) {
+  FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
+  FEATSENSE_SHARED_FILE(json, kOs1Json);
+  SourceOptions options;
+  options.meta_path = os1_metadata_with(json, "prod_sn", "122201000123", "meta_other_unit");
+  try {
+    all_scans(*open_scan_source(pcap.string(), options));
+    FAIL() << "read another unit's packets";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("all 192 lidar packets from another sensor (serial 122201000998)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("is the metadata this sensor's?"), std::string::npos) << what;
+  }
+  // The same unit initialized again since its metadata was written: read, warned once.
+  options.meta_path = os1_metadata_with(json, "initialization_id", 7109751, "meta_reinitialized");
+  std::unique_ptr<ScanSource> source = open_scan_source(pcap.string(), options);
+  EXPECT_EQ(all_scans(*source).size(), 3u);
+  ASSERT_EQ(source->stats().warning_count, 1u);
+  EXPECT_NE(source->stats().warnings[0].find("initialization id 7109750 is not the metadata's"),
+            std::string::npos)
+      << source->stats().warnings[0];
 }
 
 TEST(LiveSource, ASilentOusterEndsWithTheNoPacketsError) {

@@ -48,6 +48,8 @@ void expect_same(const OusterMetadata& a, const OusterMetadata& b) {
   EXPECT_EQ(a.beam_to_lidar, b.beam_to_lidar);
   EXPECT_EQ(a.lidar_to_sensor, b.lidar_to_sensor);
   EXPECT_EQ(a.rate_hz, b.rate_hz);
+  EXPECT_EQ(a.serial, b.serial);
+  EXPECT_EQ(a.initialization_id, b.initialization_id);
 }
 
 TEST(OusterMetadata, ReadsTheOs1SensorFile) {
@@ -75,6 +77,31 @@ TEST(OusterMetadata, ReadsTheOs1SensorFile) {
   EXPECT_EQ(meta.lidar_to_sensor[11], 36.18);
   // PACKET_FORMAT.md: 32 + 16 x (12 + 128 x 4) + 32 bytes, as the pcap's packets are.
   EXPECT_EQ(meta.packet_size(), 8448u);
+  // Who it is of: the serial is a string there, as the pcap's packet headers say
+  // (bytes 7-11: 122201000998; bytes 4-6: 7109750).
+  EXPECT_EQ(meta.serial, std::optional<uint64_t>(122201000998u));
+  EXPECT_EQ(meta.initialization_id, std::optional<uint64_t>(7109750u));
+}
+
+TEST(OusterMetadata, TheUnitsIdentityIsOptionalButNeverMalformed) {
+  json doc = test::tiny_flat_metadata("RNG19_RFL8_SIG16_NIR16");
+  EXPECT_FALSE(parse(doc).serial);
+  EXPECT_FALSE(parse(doc).initialization_id);
+  doc["prod_sn"] = 992109000123u;  // a number is taken too
+  doc["initialization_id"] = 12;
+  EXPECT_EQ(parse(doc).serial, std::optional<uint64_t>(992109000123u));
+  EXPECT_EQ(parse(doc).initialization_id, std::optional<uint64_t>(12u));
+  for (const json& bad : {json("12a4"), json(-3), json(""), json(1.5)}) {
+    doc["prod_sn"] = bad;
+    try {
+      parse(doc);
+      ADD_FAILURE() << "took prod_sn " << bad.dump();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("'prod_sn' must be a non-negative integer"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(OusterMetadata, SensorModelFollowsTheMetadata) {

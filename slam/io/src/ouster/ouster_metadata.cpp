@@ -81,6 +81,25 @@ class KeyReader {
     return out;
   }
 
+  /// A non-negative integer given as a number or a string of digits (serial numbers are
+  /// strings); nullopt where the key is absent.
+  std::optional<uint64_t> optional_id(const char* key) const {
+    if (!has(key)) return std::nullopt;
+    const json& value = get(key);
+    if (value.is_number_unsigned()) return value.get<uint64_t>();
+    if (value.is_number_integer() && value.get<int64_t>() >= 0) {
+      return static_cast<uint64_t>(value.get<int64_t>());
+    }
+    if (value.is_string()) {
+      const std::string text = value.get<std::string>();
+      if (!text.empty() && text.size() <= 19 &&
+          std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        return std::stoull(text);
+      }
+    }
+    fail(key, "must be a non-negative integer or a string of digits");
+  }
+
   /// A row-major 4x4 matrix given as 16 numbers.
   std::array<double, 16> matrix4(const char* key) const {
     const std::vector<double> values = numbers(key);
@@ -324,7 +343,10 @@ OusterMetadata parse_ouster_metadata(const std::string& json_text, const std::st
     meta.lidar_mode = config.string("lidar_mode");
     mode_holder = config;
     parse_udp_ports(config, &meta);
-    meta.prod_line = top.object("sensor_info").string("prod_line");
+    const KeyReader sensor_info = top.object("sensor_info");
+    meta.prod_line = sensor_info.string("prod_line");
+    meta.serial = sensor_info.optional_id("prod_sn");
+    meta.initialization_id = sensor_info.optional_id("initialization_id");
     // Firmware writes the profile into lidar_data_format, older nested files only into
     // config_params; absent means the legacy packet format.
     if (format.has(profile_key)) {
@@ -349,6 +371,8 @@ OusterMetadata parse_ouster_metadata(const std::string& json_text, const std::st
     meta.lidar_mode = top.string("lidar_mode");
     mode_holder = top;
     meta.prod_line = top.string("prod_line");
+    meta.serial = top.optional_id("prod_sn");
+    meta.initialization_id = top.optional_id("initialization_id");
     if (format.has(profile_key)) profile_holder = format;
   }
   if (profile_holder) {

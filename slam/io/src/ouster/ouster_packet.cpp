@@ -61,6 +61,16 @@ bool OusterPacketView::reset(const OusterPacketLayout& layout, const uint8_t* da
   return true;
 }
 
+std::optional<OusterPacketSender> ouster_packet_sender(OusterProfile profile, const uint8_t* data,
+                                                       size_t size) {
+  // The header: u16 packet type, u16 frame id, u24 init id, u40 serial (PACKET_FORMAT.md).
+  if (profile == OusterProfile::kLegacy || data == nullptr || size < 12) return std::nullopt;
+  OusterPacketSender sender;
+  sender.initialization_id = load_le_bytes(data + 4, 3);
+  sender.serial = load_le_bytes(data + 7, 5);
+  return sender;
+}
+
 uint16_t OusterPacketView::frame_id() const {
   if (layout_->profile == OusterProfile::kLegacy) {
     // Each legacy column carries its own frame id; take the first valid column's, as

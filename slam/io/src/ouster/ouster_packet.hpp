@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "featsense/slam/io/ouster_metadata.hpp"
 
@@ -39,6 +40,17 @@ struct OusterColumnHeader {
   uint16_t frame_id = 0;  ///< the packet's frame id (legacy: the column's own)
   bool valid = false;     ///< the sensor marked the column as holding data
 };
+
+/// Who sent a packet, from its header: the unit's serial number and its initialization id.
+struct OusterPacketSender {
+  uint64_t serial = 0;
+  uint64_t initialization_id = 0;
+};
+
+/// The sender of a lidar packet of `profile` (`size` bytes); nullopt in the legacy format,
+/// whose packets have no header, or where the packet is shorter than one.
+std::optional<OusterPacketSender> ouster_packet_sender(OusterProfile profile, const uint8_t* data,
+                                                       size_t size);
 
 /// A view of one packet whose size has been checked against its layout; every accessor stays
 /// inside the packet for any column index < layout.columns and pixel index < layout.pixels.

@@ -15,6 +15,7 @@
 #include "net/packet_sources.hpp"
 #include "net/pcap_datagram_feed.hpp"
 #include "ouster/ouster_imu_packet.hpp"
+#include "ouster/ouster_packet.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -139,6 +140,7 @@ class OusterPacketSource final : public ScanSource {
       return;
     }
     if (datagram->size == packet_size_) {
+      if (!from_this_sensor(datagram->payload, datagram->size)) return;
       ++lidar_packets_;
       if (std::optional<Scan> scan = assembler_.add_packet(datagram->payload, datagram->size)) {
         pending_.push_back(std::move(*scan));
@@ -156,9 +158,41 @@ class OusterPacketSource final : public ScanSource {
     note_other_size(*datagram);
   }
 
+  /// False (counted) for a packet of another unit than the metadata's: its serial number
+  /// differs. The same unit initialized again since the metadata was written is warned of
+  /// once and read: a packet of the expected size has the layout the metadata describes.
+  bool from_this_sensor(const uint8_t* payload, size_t size) {
+    const OusterMetadata& meta = assembler_.metadata();
+    const std::optional<detail::OusterPacketSender> sender =
+        detail::ouster_packet_sender(meta.profile, payload, size);
+    if (!sender) return true;
+    if (meta.serial && sender->serial != *meta.serial) {
+      if (foreign_packets_++ == 0) foreign_serial_ = sender->serial;
+      return false;
+    }
+    if (meta.initialization_id && sender->initialization_id != *meta.initialization_id &&
+        !reinitialized_warned_) {
+      reinitialized_warned_ = true;
+      warn(path_ + ": the packets' initialization id " + std::to_string(sender->initialization_id) +
+           " is not the metadata's (" + std::to_string(*meta.initialization_id) + ", " +
+           meta_path_ +
+           "): the sensor was initialized again since; read with this metadata (fetch it "
+           "again if its mode or profile changed)");
+    }
+    return true;
+  }
+
+  std::string foreign_packets_text() const {
+    return std::to_string(foreign_packets_) + " lidar packets from another sensor (serial " +
+           std::to_string(foreign_serial_) + ") than the metadata's (serial " +
+           std::to_string(assembler_.metadata().serial.value_or(0)) + ", " + meta_path_ + ")";
+  }
+
   void end_of_capture() {
     ended_ = true;
     for (const std::string& warning : feed_->end_warnings()) warn(warning);
+    if (foreign_packets_ > 0 && lidar_packets_ > 0)
+      warn(path_ + ": " + foreign_packets_text() + "; skipped");
     if (malformed_imu_packets_ > 0) {
       warn(path_ + ": " + std::to_string(malformed_imu_packets_) + " packets on the IMU port " +
            std::to_string(imu_port_) + " were not " +
@@ -192,7 +226,9 @@ class OusterPacketSource final : public ScanSource {
 
   std::string no_frames_message() const {
     std::string message = path_ + ": ";
-    if (lidar_packets_ > 0) {
+    if (lidar_packets_ == 0 && foreign_packets_ > 0) {
+      message += "all " + foreign_packets_text() + ": is the metadata this sensor's?";
+    } else if (lidar_packets_ > 0) {
       message += std::to_string(lidar_packets_) +
                  " lidar packets, but none holds a valid column, so there is no frame";
     } else {
@@ -235,6 +271,9 @@ class OusterPacketSource final : public ScanSource {
   SourceInfo info_;
   size_t packet_size_ = 0;
   size_t lidar_packets_ = 0;
+  size_t foreign_packets_ = 0;   ///< of the right size, from another unit
+  uint64_t foreign_serial_ = 0;  ///< the first such unit's serial number
+  bool reinitialized_warned_ = false;
   size_t incomplete_seen_ = 0;
   bool ended_ = false;
   bool imu_checked_ = false;

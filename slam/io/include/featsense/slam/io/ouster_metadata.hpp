@@ -3,6 +3,8 @@
 /// newer nested one; slam/io/src/ouster/PACKET_FORMAT.md lists the keys).
 
 #include <array>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +30,10 @@ struct OusterMetadata {
   std::array<double, 16> lidar_to_sensor = {};  ///< row-major 4x4, translation in mm
   /// Row-major 4x4, translation in mm; identity where the metadata has none.
   std::array<double, 16> imu_to_sensor = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  /// Who the metadata is of, where it says (the packets' headers carry both, not the legacy
+  /// format's): the unit's serial number, and the id of its last initialization.
+  std::optional<uint64_t> serial;
+  std::optional<uint64_t> initialization_id;
   int udp_port_lidar = 7502;  ///< the sensor's defaults where the metadata names none
   int udp_port_imu = 7503;
   double rate_hz = 10.0;  ///< from lidar_mode
