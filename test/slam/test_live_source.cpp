@@ -42,6 +42,30 @@ detail::UdpListenSettings loopback(std::vector<int> ports) {
   return s;
 }
 
+/// An Ouster live source's options: two free ports of 127.0.0.1, the input ending after
+/// `idle_s` seconds without a datagram.
+LiveOptions loopback_ouster(double idle_s) {
+  LiveOptions live;
+  live.host = "127.0.0.1";
+  live.lidar_port = test::free_udp_port();
+  live.imu_port = test::free_udp_port();
+  live.idle_timeout_s = idle_s;
+  return live;
+}
+
+/// The capture's datagrams, each to `live`'s port for its kind (IMU packets were on 7503).
+std::vector<test::Outgoing> addressed_to(const std::filesystem::path& pcap,
+                                         const LiveOptions& live) {
+  std::vector<test::Outgoing> out;
+  std::ifstream stream(pcap, std::ios::binary);
+  detail::PcapUdpReader reader(stream, pcap.string());
+  while (const std::optional<detail::UdpDatagram> d = reader.next()) {
+    out.push_back({d->destination_port == 7503 ? *live.imu_port : *live.lidar_port,
+                   std::vector<uint8_t>(d->payload, d->payload + d->size)});
+  }
+  return out;
+}
+
 TEST(UdpReceiver, HandsOutDatagramsInOrderWithTheirPort) {
   const int a = test::free_udp_port();
   const int b = test::free_udp_port();
@@ -139,19 +163,8 @@ TEST(LiveSource, OusterPacketsOverTheNetworkGiveThePcapsScans) {
   const std::vector<Scan> expected = all_scans(*open_scan_source(pcap.string(), options));
   ASSERT_EQ(expected.size(), 3u);
 
-  // The capture's datagrams, each to the live source's port for its kind.
-  LiveOptions live;
-  live.host = "127.0.0.1";
-  live.lidar_port = test::free_udp_port();
-  live.imu_port = test::free_udp_port();
-  live.idle_timeout_s = 1.0;
-  std::vector<test::Outgoing> out;
-  std::ifstream stream(pcap, std::ios::binary);
-  detail::PcapUdpReader reader(stream, pcap.string());
-  while (const std::optional<detail::UdpDatagram> d = reader.next()) {
-    out.push_back({d->destination_port == 7503 ? *live.imu_port : *live.lidar_port,
-                   std::vector<uint8_t>(d->payload, d->payload + d->size)});
-  }
+  const LiveOptions live = loopback_ouster(1.0);
+  const std::vector<test::Outgoing> out = addressed_to(pcap, live);
   std::unique_ptr<ScanSource> source = open_live_source(live, options);
   EXPECT_EQ(source->info().format, "ouster-live");
   EXPECT_EQ(source->info().sensor.beams, 128);
@@ -185,21 +198,14 @@ TEST(LiveSource, AnotherSensorsPacketsOnThePortAreSkippedAndCounted) {
   SourceOptions options;
   options.meta_path = json.string();
   const std::vector<Scan> expected = all_scans(*open_scan_source(pcap.string(), options));
-  LiveOptions live;
-  live.host = "127.0.0.1";
-  live.lidar_port = test::free_udp_port();
-  live.imu_port = test::free_udp_port();
-  live.idle_timeout_s = 1.0;
+  const LiveOptions live = loopback_ouster(1.0);
   // Every lidar packet twice: as recorded, and as a second unit (serial + 1) would send it.
   std::vector<test::Outgoing> out;
-  std::ifstream stream(pcap, std::ios::binary);
-  detail::PcapUdpReader reader(stream, pcap.string());
-  while (const std::optional<detail::UdpDatagram> d = reader.next()) {
-    std::vector<uint8_t> bytes(d->payload, d->payload + d->size);
-    out.push_back({*live.lidar_port, bytes});
-    if (d->size == 8448) {
-      ++bytes[7];  // the serial's lowest byte (PACKET_FORMAT.md)
-      out.push_back({*live.lidar_port, bytes});
+  for (test::Outgoing& recorded : addressed_to(pcap, live)) {
+    out.push_back(recorded);
+    if (recorded.bytes.size() == 8448) {
+      ++recorded.bytes[7];  // the serial's lowest byte (PACKET_FORMAT.md)
+      out.push_back(std::move(recorded));
     }
   }
   std::unique_ptr<ScanSource> source = open_live_source(live, options);
@@ -245,12 +251,7 @@ TEST(LiveSource, ASilentOusterEndsWithTheNoPacketsError) {
   FEATSENSE_SHARED_FILE(json, kOs1Json);
   SourceOptions options;
   options.meta_path = json.string();
-  LiveOptions live;
-  live.host = "127.0.0.1";
-  live.lidar_port = test::free_udp_port();
-  live.imu_port = test::free_udp_port();
-  live.idle_timeout_s = 0.3;
-  std::unique_ptr<ScanSource> source = open_live_source(live, options);
+  std::unique_ptr<ScanSource> source = open_live_source(loopback_ouster(0.3), options);
   try {
     source->next();
     FAIL() << "a scan from silence";
@@ -286,11 +287,7 @@ ReplayedOs1 replay_os1(const std::filesystem::path& pcap, const std::filesystem:
                        ReplaySettings settings) {
   SourceOptions options;
   options.meta_path = json.string();
-  LiveOptions live;
-  live.host = "127.0.0.1";
-  live.lidar_port = test::free_udp_port();
-  live.imu_port = test::free_udp_port();
-  live.idle_timeout_s = 1.0;
+  const LiveOptions live = loopback_ouster(1.0);
   std::unique_ptr<ScanSource> source = open_live_source(live, options);
   settings.ports = {{7502, *live.lidar_port}, {7503, *live.imu_port}};
   ReplayedOs1 out;

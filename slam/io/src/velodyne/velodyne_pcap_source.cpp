@@ -2,13 +2,11 @@
 // packets of 1206 bytes (port 2368 by default; position packets of 512 bytes on 8308 and
 // anything else are passed over), read as a stream of scans.
 
-#include <fstream>
 #include <vector>
 
 #include "featsense/slam/io/readers.hpp"
 #include "net/packet_sources.hpp"
 #include "net/pcap_datagram_feed.hpp"
-#include "ouster/pcap_udp_reader.hpp"
 #include "velodyne/velodyne_setup.hpp"
 
 namespace featsense::slam {
@@ -66,10 +64,9 @@ class VelodynePacketSource final : public ScanSource {
 
 /// The first Velodyne data packet among the first datagrams, if any.
 std::optional<std::vector<uint8_t>> first_velodyne_packet(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  detail::PcapUdpReader reader(stream, path);
+  detail::PcapDatagramFeed feed(path);
   for (size_t i = 0; i < kProbeDatagrams; ++i) {
-    const std::optional<detail::UdpDatagram> datagram = reader.next();
+    const std::optional<detail::UdpDatagram> datagram = feed.next();
     if (!datagram) break;
     if (datagram->size == kVelodynePacketBytes) {
       return std::vector<uint8_t>(datagram->payload, datagram->payload + datagram->size);
