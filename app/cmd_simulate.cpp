@@ -1,5 +1,6 @@
 // featsense simulate: a spinning LiDAR moving through a built-in scene or a mesh file,
-// written as a recording folder (sequence.yaml + PCD frames) with its ground truth.
+// written as a recording folder (sequence.yaml + PCD frames) or as the sensor's packets in a
+// pcap, with its ground truth.
 
 #include <spdlog/spdlog.h>
 #include <tbb/global_control.h>
@@ -8,9 +9,13 @@
 #include <chrono>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <optional>
 
 #include "commands.hpp"
+#include "featsense/slam/io/pcap_recorders.hpp"
+#include "featsense/slam/io/scan_writers.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 #include "featsense/slam/sim/simulation_writer.hpp"
@@ -25,6 +30,13 @@ double thread_cpu_ms() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw slam::WriteError(path.string() + ": cannot write");
 }
 
 }  // namespace
@@ -68,7 +80,15 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   const uint64_t frames = prepared.frames;
   const slam::PoseCurve* trajectory = prepared.trajectory.get();
 
-  slam::SimulationWriter writer(o.output_dir, settings.sensor);
+  const bool to_folder = o.format == "folder";
+  // Creates the folder, so it comes before the pcap.
+  slam::SimulationWriter writer(o.output_dir, settings.sensor, 0.02, to_folder);
+  std::unique_ptr<slam::OusterPcapRecorder> ouster;
+  const std::filesystem::path pcap_path = std::filesystem::path(o.output_dir) / "recording.pcap";
+  if (o.format == "ouster-pcap") {
+    ouster = std::make_unique<slam::OusterPcapRecorder>(pcap_path.string(), settings.sensor);
+    write_text(std::filesystem::path(o.output_dir) / "recording.json", ouster->metadata_json());
+  }
   Progress progress("frames", frames, context.quiet);
   std::vector<double> frame_ms;
   // CPU time of the calling thread: with --threads 1 the whole cost of a frame, free of what
@@ -83,9 +103,15 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
     writer.add(frame, trajectory->pose(frame.start_s));
+    if (ouster) ouster->add(frame.scan);
     progress.update(i + 1);
   }
   writer.finish(mesh);
+  if (ouster) {
+    ouster->finish();
+    spdlog::info("{}: {} lidar and {} IMU packets (metadata in recording.json)", pcap_path.string(),
+                 ouster->lidar_packets(), ouster->imu_packets());
+  }
   progress.finish();
   std::sort(frame_ms.begin(), frame_ms.end());
   const double median_ms = frame_ms[frame_ms.size() / 2];
@@ -132,6 +158,13 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   command->add_option("--up-axis", o->up_axis, "Up axis of the mesh file: auto, y or z")
       ->check(CLI::IsMember({"auto", "y", "z"}))
+      ->capture_default_str();
+  command
+      ->add_option("--format", o->format,
+                   "What the frames are written as: folder (sequence.yaml and PCD frames), or "
+                   "ouster-pcap (recording.pcap of an Ouster's lidar and IMU packets, with its "
+                   "metadata in recording.json)")
+      ->check(CLI::IsMember({"folder", "ouster-pcap"}))
       ->capture_default_str();
   command->add_option("--threads", o->threads, "Worker threads (default: all cores)")
       ->check(CLI::PositiveNumber);

@@ -28,6 +28,9 @@ struct SimulateOptions {
   bool no_dropouts = false;
   bool no_mixed_pixels = false;
   int threads = 0;  ///< 0: all cores
+  /// What the frames are written as: "folder" (sequence.yaml + PCD frames + imu.csv), or
+  /// "ouster-pcap" (recording.pcap of the sensor's packets + recording.json, its metadata).
+  std::string format = "folder";
 };
 
 /// What `o` asks to simulate, its scene loaded where it is a mesh file (assimp: unit scale,
@@ -35,7 +38,7 @@ struct SimulateOptions {
 /// built-in scene's name.
 slam::SimulationRequest simulation_request(const SimulateOptions& o);
 
-/// Simulates the scene into o.output_dir (sequence.yaml, frames, ground truth). Throws
+/// Simulates the scene into o.output_dir (the frames in o.format, ground truth). Throws
 /// ConfigError, InputError or std::runtime_error.
 void run_simulate(const SimulateOptions& o, const CliContext& context);
 

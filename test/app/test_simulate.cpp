@@ -58,6 +58,40 @@ TEST(CliSimulate, SensorFromOusterMetadata) {
   EXPECT_EQ(j["cols"], 1024);
 }
 
+TEST(CliSimulate, OusterPacketsReadBackAsTheFolderOfTheSameRun) {
+  const auto dir = scratch_dir("cli_simulate_pcap");
+  const std::string pcap_out = (dir / "pcap").string();
+  const std::string folder_out = (dir / "folder").string();
+  const std::string args = "simulate --quiet --scene lab --frames 2 --rate 20 --seed 4 ";
+  const CommandResult pcap = run_featsense(args + "--format ouster-pcap -o " + pcap_out);
+  ASSERT_EQ(pcap.exit_code, 0) << pcap.output;
+  for (const char* name : {"recording.pcap", "recording.json", "gt_trajectory.tum", "gt_mesh.ply"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "pcap" / name)) << name;
+  EXPECT_FALSE(std::filesystem::exists(dir / "pcap" / "sequence.yaml"));  // no frame files
+  const CommandResult folder = run_featsense(args + "-o " + folder_out);
+  ASSERT_EQ(folder.exit_code, 0) << folder.output;
+  // The same ground truth, and the pcap reads back as the folder's scans: the same image and
+  // the same returns (ranges to the millimetre; test_pcap_recorders.cpp checks each point).
+  EXPECT_EQ(file_bytes(dir / "pcap" / "gt_trajectory.tum"),
+            file_bytes(dir / "folder" / "gt_trajectory.tum"));
+  const CommandResult a = run_featsense("info --quiet --json - " + pcap_out + "/recording.pcap");
+  const CommandResult b = run_featsense("info --quiet --json - " + folder_out);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const nlohmann::json ja = nlohmann::json::parse(a.output);
+  const nlohmann::json jb = nlohmann::json::parse(b.output);
+  EXPECT_EQ(ja["frames"], 2);
+  EXPECT_EQ(ja["rows"], jb["rows"]);
+  EXPECT_EQ(ja["cols"], jb["cols"]);
+  EXPECT_EQ(ja["valid_points"], jb["valid_points"]);
+  EXPECT_EQ(ja["warnings"], 0);
+  // A rate that Ouster's modes cannot say is one clear error.
+  const CommandResult bad = run_featsense(
+      "simulate --quiet --scene lab --frames 1 --rate 12.5 --format ouster-pcap -o " + pcap_out);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("whole number"), std::string::npos) << bad.output;
+}
+
 TEST(CliSimulate, SameSeedSameFilesOtherSeedOtherNoise) {
   const auto dir = scratch_dir("cli_simulate_seed");
   for (const std::string run : {"a", "b", "c"}) {
