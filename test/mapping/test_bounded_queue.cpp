@@ -63,5 +63,34 @@ TEST(BoundedQueue, AWaitingConsumerWakesWhenTheQueueCloses) {
   EXPECT_EQ(got, std::nullopt);
 }
 
+TEST(BoundedQueue, APushThatMustNotWaitDropsTheOldestItem) {
+  BoundedQueue<int> queue(2);
+  using Pushed = BoundedQueue<int>::Pushed;
+  int dropped = 0;
+  EXPECT_EQ(queue.push_dropping_oldest(1, &dropped), Pushed::kQueued);
+  EXPECT_FALSE(queue.full());
+  EXPECT_EQ(queue.push_dropping_oldest(2, &dropped), Pushed::kQueued);
+  EXPECT_TRUE(queue.full());
+  EXPECT_EQ(queue.push_dropping_oldest(3, &dropped), Pushed::kDroppedOldest);
+  EXPECT_EQ(dropped, 1);
+  EXPECT_EQ(queue.pop(), 2);
+  EXPECT_EQ(queue.pop(), 3);
+  queue.close();
+  EXPECT_EQ(queue.push_dropping_oldest(4), Pushed::kClosed);
+}
+
+TEST(BoundedQueue, SmallItemsMayGoPastTheCapacityInOrder) {
+  BoundedQueue<int> queue(1);
+  ASSERT_TRUE(queue.push(1));
+  EXPECT_TRUE(queue.push_past_capacity(2));  // does not wait on the full queue
+  EXPECT_TRUE(queue.push_past_capacity(3));
+  EXPECT_EQ(queue.pop(), 1);
+  EXPECT_TRUE(queue.full());  // still two in line
+  EXPECT_EQ(queue.pop(), 2);
+  EXPECT_EQ(queue.pop(), 3);
+  queue.abandon();
+  EXPECT_FALSE(queue.push_past_capacity(4));
+}
+
 }  // namespace
 }  // namespace featsense::mapping

@@ -115,6 +115,109 @@ TEST(MapPipeline, EachScansLatencyIsMeasuredFromItsSourceToTheMap) {
   }
 }
 
+/// A live sensor's pace: another source's scans, made first, then handed out `period` apart.
+class PacedSource : public slam::ScanSource {
+ public:
+  PacedSource(std::unique_ptr<slam::ScanSource> inner, std::chrono::milliseconds period)
+      : info_(inner->info()), period_(period) {
+    while (std::optional<slam::Scan> scan = inner->next()) scans_.push_back(std::move(*scan));
+  }
+  std::optional<slam::Scan> next() override {
+    std::this_thread::sleep_for(period_);
+    if (next_ == scans_.size()) return std::nullopt;
+    return std::move(scans_[next_++]);
+  }
+  const slam::SourceInfo& info() const override { return info_; }
+
+ private:
+  slam::SourceInfo info_;
+  std::chrono::milliseconds period_;
+  std::vector<slam::Scan> scans_;
+  size_t next_ = 0;
+};
+
+/// The box room seen by a VLP-16: small scans, quick to make.
+slam::BoxRoomSettings small_scans_room(int frames) {
+  slam::BoxRoomSettings room = small_room(frames);
+  room.sensor = config::sensor_preset("vlp16");
+  return room;
+}
+
+PassSettings real_time_pass() {
+  PassSettings settings;
+  settings.real_time = true;
+  return settings;
+}
+
+TEST(MapPipeline, InRealTimeAnOdometryThatFallsBehindLosesTheOldestScansCounted) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_real_time_odometry");
+  const slam::BoxRoomSettings room = small_scans_room(24);
+  config::Config config = test::small_map_config();
+  // Scans 2 ms apart, 30 ms to place each: the odometry cannot keep up.
+  SlowLocator locator(test::room_path(room), std::chrono::milliseconds(30));
+  PacedSource source(slam::make_box_room_source(room), std::chrono::milliseconds(2));
+  MapPass pass(locator, real_time_pass(), config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, {});
+  const PassResult result = run_pipeline(source, pass);
+  const RealTimeCounts& kept_up = result.real_time;
+  EXPECT_TRUE(kept_up.enabled);
+  EXPECT_EQ(result.frames_read, 24u);  // the reader never waited for the odometry
+  EXPECT_GT(kept_up.scans_dropped_odometry_behind, 0u);
+  EXPECT_EQ(kept_up.scans_dropped_refinement_behind, 0u);  // no refinement in this pass
+  // Every scan is accounted for: placed (integrated or not) or dropped, and every placed
+  // scan has its pose.
+  EXPECT_EQ(result.frames_mapped + kept_up.integrations_skipped + kept_up.scans_dropped(), 24u);
+  EXPECT_EQ(result.poses.size(), 24u - kept_up.scans_dropped());
+  // The oldest waiting scan is the one dropped: the last scan is always placed.
+  EXPECT_EQ(result.poses.stamps_ns.back(),
+            room.start_stamp_ns + static_cast<int64_t>(23 * 1e9 / room.sensor.rate_hz));
+  for (const Eigen::Isometry3d& pose : result.poses.poses) EXPECT_TRUE(pose.matrix().allFinite());
+  EXPECT_EQ(result.timings.latency_pose_ms.size(), result.poses.size());
+}
+
+TEST(MapPipeline, InRealTimeATsdfThatFallsBehindSkipsIntegrationsKeepingEveryPose) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_real_time_tsdf");
+  const slam::BoxRoomSettings room = small_scans_room(30);
+  config::Config config = test::small_map_config();
+  const auto locator = slam::make_given_pose_locator(test::room_path(room), true);
+  // Scans 5 ms apart; the mapping thread takes 40 ms more over each scan it integrates.
+  RunEvents events;
+  events.progress = [](const RunProgress&) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  };
+  PacedSource source(slam::make_box_room_source(room), std::chrono::milliseconds(5));
+  MapPass pass(*locator, real_time_pass(), config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, events);
+  const PassResult result = run_pipeline(source, pass);
+  const RealTimeCounts& kept_up = result.real_time;
+  EXPECT_EQ(kept_up.scans_dropped(), 0u);  // placing is instant: no scan lost
+  EXPECT_GT(kept_up.integrations_skipped, 0u);
+  EXPECT_GT(result.frames_mapped, 0u);
+  EXPECT_EQ(result.frames_mapped + kept_up.integrations_skipped, 30u);
+  // Every scan's pose, in order, whether integrated or not; the store keeps them all.
+  ASSERT_EQ(result.poses.size(), 30u);
+  for (size_t k = 1; k < 30; ++k)
+    EXPECT_GT(result.poses.stamps_ns[k], result.poses.stamps_ns[k - 1]);
+  EXPECT_EQ(result.timings.latency_integrated_ms.size(), result.frames_mapped);
+  EXPECT_FALSE(read_chunks(dir / "map.h5").empty());
+  storage::Hdf5ChunkStore store(dir / "map.h5");
+  EXPECT_EQ(store.read_trajectory().size(), 30u);
+}
+
+TEST(MapPipeline, WithoutRealTimeNothingIsSkippedHoweverSlowAStage) {
+  const std::filesystem::path dir = test::scratch_dir("pipeline_not_real_time");
+  const slam::BoxRoomSettings room = small_scans_room(12);
+  config::Config config = test::small_map_config();
+  SlowLocator locator(test::room_path(room), std::chrono::milliseconds(10));
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  MapPass pass(locator, PassSettings{}, config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, {});
+  const PassResult result = run_pipeline(*source, pass);
+  EXPECT_FALSE(result.real_time.enabled);
+  EXPECT_EQ(result.frames_mapped, 12u);
+  EXPECT_EQ(result.real_time.scans_dropped() + result.real_time.integrations_skipped, 0u);
+}
+
 TEST(MapPipeline, MakesTheSameMapAsAddingTheScansOneByOne) {
   const std::filesystem::path dir = test::scratch_dir("pipeline_same_map");
   const slam::BoxRoomSettings room = small_room();

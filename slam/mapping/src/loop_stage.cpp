@@ -25,11 +25,12 @@ slam::Trajectory corrected_path(const slam::loops::TrajectoryCorrection& correct
 }
 
 LoopStage::LoopStage(const slam::loops::LoopSettings& settings,
-                     std::optional<RelocalizeStage> relocalize)
+                     std::optional<RelocalizeStage> relocalize, bool never_wait)
     : settings_(settings),
       selector_(settings.keyframe_distance_m, settings.keyframe_angle_deg),
       closer_(settings),
       queue_(kKeyframesQueued),
+      never_wait_(never_wait),
       relocalize_(relocalize),
       worker_([this] { work(); }) {}
 
@@ -64,6 +65,11 @@ bool LoopStage::offer(const slam::Scan& scan, const slam::ScanPlacement& placeme
   travelled_m_.push_back(selector_.travelled_m());
   slam::loops::append_in_time_order(&imu_, scan.imu);
   if (!keyframe) return true;
+  // Only this thread pushes: a queue found not full takes the job without waiting.
+  if (never_wait_ && queue_.full()) {
+    ++keyframes_skipped_;
+    return true;
+  }
   KeyframeJob job;
   job.stamp_ns = placement.stamp_ns;
   job.travelled_m = selector_.travelled_m();

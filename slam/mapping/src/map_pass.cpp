@@ -64,7 +64,9 @@ MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings,
     refiner_ = std::make_unique<slam::refine::PlacementRefiner>(*settings_.refine);
     result_.unrefined_poses.emplace();
   }
-  if (settings_.loops) loops_ = std::make_unique<LoopStage>(*settings_.loops, settings_.relocalize);
+  if (settings_.loops)
+    loops_ =
+        std::make_unique<LoopStage>(*settings_.loops, settings_.relocalize, settings_.real_time);
 }
 
 MapPass::~MapPass() {
@@ -142,16 +144,24 @@ std::vector<PlacedScan> MapPass::finish_refinement() {
   return out;
 }
 
-std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed) {
+void MapPass::count_dropped(uint64_t sequence, ScanDrop why) {
+  latency_.since_ready(sequence, true);  // forgotten: no stage will see it
+  (why == ScanDrop::kOdometryBehind ? dropped_odometry_behind_ : dropped_refinement_behind_)
+      .fetch_add(1);
+}
+
+std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed, bool skip_integration) {
   const Clock::time_point start = Clock::now();
+  const bool integrates = settings_.integrate && !skip_integration;
   if (const std::optional<double> ms =
-          latency_.since_ready(placed.placement.sequence, !settings_.integrate)) {
+          latency_.since_ready(placed.placement.sequence, !integrates)) {
     result_.timings.latency_final_pose_ms.push_back(*ms);
   }
   if (loops_ && !loops_->offer(placed.scan, placed.placement)) return std::nullopt;
   if (loops_) result_.scan_motions.add(placed.scan, placed.placement);
   LocatedScan located;
-  if (settings_.integrate) located.rays = scan_to_rays(placed.scan, placed.placement);
+  located.integrate = integrates;
+  if (integrates) located.rays = scan_to_rays(placed.scan, placed.placement);
   located.placement = std::move(placed.placement);
   result_.timings.rays_ms.push_back(ms_since(start));
   return located;
@@ -167,6 +177,11 @@ void MapPass::open_map(const LocatedScan& first) {
 }
 
 void MapPass::integrate(LocatedScan scan) {
+  if (settings_.integrate && !scan.integrate) {  // skipped to keep up: the pose only
+    result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
+    ++result_.real_time.integrations_skipped;
+    return;
+  }
   if (!settings_.integrate) {
     result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
     ++result_.frames_mapped;
@@ -274,6 +289,10 @@ PassResult MapPass::close() {
       result_.timings.loops_finish_ms = ms_since(start);
     }
     result_.frames_read = frames_read_.load();
+    result_.real_time.enabled = settings_.real_time;
+    result_.real_time.scans_dropped_odometry_behind = dropped_odometry_behind_.load();
+    result_.real_time.scans_dropped_refinement_behind = dropped_refinement_behind_.load();
+    if (loops_) result_.real_time.keyframes_skipped = loops_->keyframes_skipped();
     result_.wall_s = std::chrono::duration<double>(Clock::now() - started_).count();
     result_.interrupted = events_.stop.stop_requested();
     if (!result_.poses.empty()) {

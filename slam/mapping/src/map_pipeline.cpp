@@ -62,8 +62,28 @@ bool after_range(const slam::Scan& scan, const FrameRange& range, int64_t first_
   return range.last_s && static_cast<double>(scan.stamp_ns - first_stamp_ns) * 1e-9 > *range.last_s;
 }
 
+/// Real time: the scan goes in line without waiting; where the line was full its oldest scan
+/// is dropped, counted by what held the odometry up. False once the line is closed.
+bool push_never_waiting(slam::Scan scan, MapPass& pass, BoundedQueue<slam::Scan>& out,
+                        const BoundedQueue<PlacedScan>& to_refinement) {
+  slam::Scan dropped;
+  switch (out.push_dropping_oldest(std::move(scan), &dropped)) {
+    case BoundedQueue<slam::Scan>::Pushed::kQueued:
+      return true;
+    case BoundedQueue<slam::Scan>::Pushed::kDroppedOldest:
+      pass.count_dropped(dropped.sequence, pass.refines() && to_refinement.full()
+                                               ? ScanDrop::kRefinementBehind
+                                               : ScanDrop::kOdometryBehind);
+      return true;
+    case BoundedQueue<slam::Scan>::Pushed::kClosed:
+      break;
+  }
+  return false;
+}
+
 void read_scans(slam::ScanSource& source, const FrameRange& range, MapPass& pass,
-                BoundedQueue<slam::Scan>& out, const PipelineState& state) {
+                BoundedQueue<slam::Scan>& out, const BoundedQueue<PlacedScan>& to_refinement,
+                const PipelineState& state) {
   std::optional<int64_t> first_stamp_ns;
   while (!state.stopping()) {
     const Clock::time_point start = Clock::now();
@@ -78,7 +98,10 @@ void read_scans(slam::ScanSource& source, const FrameRange& range, MapPass& pass
     }
     pass.add_read_time(ms_since(start));
     pass.mark_ready(scan->sequence);
-    if (!out.push(std::move(*scan))) break;
+    const bool queued = pass.real_time()
+                            ? push_never_waiting(std::move(*scan), pass, out, to_refinement)
+                            : out.push(std::move(*scan));
+    if (!queued) break;
   }
 }
 
@@ -108,11 +131,16 @@ void refine_scans(MapPass& pass, BoundedQueue<PlacedScan>& in, BoundedQueue<Plac
 
 /// Rays in a stage of their own: with odometry the front end is the pipeline's slowest
 /// stage, and the deskewing of every point need not wait for it. The poses are final here:
-/// the loop closure sees each scan too.
+/// the loop closure sees each scan too. Real time: while the TSDF's line is full, scans go on
+/// as poses only (this is the line's one producer: found not full, it takes the scan at once).
 void make_rays(MapPass& pass, BoundedQueue<PlacedScan>& in, BoundedQueue<LocatedScan>& out) {
   while (std::optional<PlacedScan> placed = in.pop()) {
-    std::optional<LocatedScan> located = pass.make_rays(std::move(*placed));
-    if (!located || !out.push(std::move(*located))) break;
+    const bool skip = pass.real_time() && out.full();
+    std::optional<LocatedScan> located = pass.make_rays(std::move(*placed), skip);
+    if (!located) break;
+    const bool queued =
+        skip ? out.push_past_capacity(std::move(*located)) : out.push(std::move(*located));
+    if (!queued) break;
   }
 }
 
@@ -126,16 +154,17 @@ void drive_pass(slam::ScanSource& source, MapPass& pass, const PipelineSettings&
   pass.set_total_frames(source.info().frames);
   PipelineState state(pass);
   BoundedQueue<slam::Scan> scans(settings.queue_capacity);
-  // Before a refinement the odometry runs ahead while a stretch is registered: a deeper queue.
-  BoundedQueue<PlacedScan> placed(pass.refines() ? 4 * settings.queue_capacity
-                                                 : settings.queue_capacity);
+  // Before a refinement the odometry runs ahead while a stretch is registered: a deeper queue,
+  // deeper still in real time, where the odometry must not wait for a stretch that takes long.
+  const size_t refine_depth = (pass.real_time() ? 8 : 4) * settings.queue_capacity;
+  BoundedQueue<PlacedScan> placed(pass.refines() ? refine_depth : settings.queue_capacity);
   BoundedQueue<PlacedScan> refined(settings.queue_capacity);
   BoundedQueue<LocatedScan> located(settings.queue_capacity);
 
   // Each stage closes its output when it ends, so the next one drains and ends too; a
   // failing stage abandons its input so the one before it cannot block on a full queue.
   std::thread reader([&] {
-    guarded(state, [&] { read_scans(source, settings.range, pass, scans, state); });
+    guarded(state, [&] { read_scans(source, settings.range, pass, scans, placed, state); });
     scans.close();
   });
   std::thread front_end([&] {

@@ -56,6 +56,7 @@ Mapper::Mapper(MapperSettings settings, RunEvents events)
   }
   pass_settings_ = pass_settings(config);
   pass_settings_.integrate = settings_.integrate;
+  pass_settings_.real_time = settings_.real_time;
   if (odometry_ && config.refine.enabled) pass_settings_.refine = slam::refine::from_config(config);
   loops_off_because_ = loop_closure_off_because(odometry_ != nullptr, config);
   if (loops_off_because_.empty()) pass_settings_.loops = slam::loops::from_config(config);

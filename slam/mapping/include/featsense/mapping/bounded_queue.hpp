@@ -1,7 +1,9 @@
 #pragma once
 // A queue of fixed capacity between two pipeline threads: a full queue makes the producer
 // wait (back-pressure instead of unbounded memory), a closed queue lets the consumer drain
-// what is left and then tells it that nothing more comes.
+// what is left and then tells it that nothing more comes. A producer that must not wait (a
+// live sensor's scans) uses the pushes that never block: one that drops the oldest item, one
+// that tells the queue is full, and one for small items that may exceed the capacity.
 
 #include <condition_variable>
 #include <deque>
@@ -23,6 +25,41 @@ class BoundedQueue {
     items_.push_back(std::move(item));
     not_empty_.notify_one();
     return true;
+  }
+
+  /// What a push that never waits did.
+  enum class Pushed { kQueued, kDroppedOldest, kClosed };
+
+  /// Never waits: a full queue drops its oldest item to make room (the freshest data wins),
+  /// moved into `dropped` where given.
+  Pushed push_dropping_oldest(T item, T* dropped = nullptr) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return Pushed::kClosed;
+    Pushed outcome = Pushed::kQueued;
+    if (items_.size() >= capacity_) {
+      if (dropped != nullptr) *dropped = std::move(items_.front());
+      items_.pop_front();
+      outcome = Pushed::kDroppedOldest;
+    }
+    items_.push_back(std::move(item));
+    not_empty_.notify_one();
+    return outcome;
+  }
+
+  /// Never waits and never drops: for small items (a pose) that must keep their place in
+  /// line even while the queue holds its capacity of large ones. False once closed.
+  bool push_past_capacity(T item) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return false;
+    items_.push_back(std::move(item));
+    not_empty_.notify_one();
+    return true;
+  }
+
+  /// Whether a push would wait now.
+  bool full() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return items_.size() >= capacity_;
   }
 
   /// Waits for an item; nullopt once the queue is closed and empty.
@@ -55,7 +92,7 @@ class BoundedQueue {
 
  private:
   size_t capacity_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable not_full_;
   std::condition_variable not_empty_;
   std::deque<T> items_;

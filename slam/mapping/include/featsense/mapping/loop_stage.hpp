@@ -60,8 +60,11 @@ struct RelocalizeStage {
 
 class LoopStage {
  public:
+  /// `never_wait` (real time): a keyframe that finds the loop thread 8 keyframes behind is
+  /// skipped, counted, rather than waited for.
   explicit LoopStage(const slam::loops::LoopSettings& settings,
-                     std::optional<RelocalizeStage> relocalize = std::nullopt);
+                     std::optional<RelocalizeStage> relocalize = std::nullopt,
+                     bool never_wait = false);
   ~LoopStage();
   LoopStage(const LoopStage&) = delete;
   LoopStage& operator=(const LoopStage&) = delete;
@@ -79,6 +82,8 @@ class LoopStage {
   /// scan's pose corrected by the graph as it is then.
   slam::loops::LoopCloser& closer_after_finish();
   slam::Trajectory corrected() const;
+  /// Keyframes skipped because the loop thread was behind (never_wait).
+  size_t keyframes_skipped() const { return keyframes_skipped_; }
 
  private:
   struct KeyframeJob {
@@ -101,6 +106,8 @@ class LoopStage {
   double wait_ms_ = 0.0;
   std::vector<double> cloud_ms_;
   bool finished_ = false;
+  bool never_wait_ = false;
+  size_t keyframes_skipped_ = 0;
   std::optional<RelocalizeStage> relocalize_;
   std::atomic<bool> relocalize_gave_up_{false};
   std::thread worker_;  ///< last: it starts once everything it uses is there

@@ -57,6 +57,9 @@ struct PassSettings {
   std::optional<RelocalizeStage> relocalize;
   /// False: the poses only, nothing integrated and no store opened.
   bool integrate = true;
+  /// A live source: the pipeline's real-time policy (map_pipeline.hpp) keeps the odometry at
+  /// the sensor's pace; the loop closure skips keyframes rather than wait.
+  bool real_time = false;
 };
 
 /// map.flush_interval and sensor.drop_mixed_pixels of `config`: a pass that integrates, with
@@ -73,7 +76,12 @@ struct PlacedScan {
 struct LocatedScan {
   slam::ScanPlacement placement;
   tsdf::RayBatch rays;
+  /// False: the real-time policy skipped its integration (no rays); its pose is kept.
+  bool integrate = true;
 };
+
+/// Why the real-time policy dropped a whole scan before the odometry.
+enum class ScanDrop { kOdometryBehind, kRefinementBehind };
 
 class MapPass {
  public:
@@ -94,6 +102,9 @@ class MapPass {
   /// Scan `sequence` was handed out now: its latencies count from here (a scan given to
   /// locate() without this counts from that call).
   void mark_ready(uint64_t sequence) { latency_.ready(sequence); }
+  /// The reader's stage, real time: a scan dropped unplaced (thread-safe).
+  void count_dropped(uint64_t sequence, ScanDrop why);
+  bool real_time() const { return settings_.real_time; }
   /// Whether the pass holds scans for a refinement (the pipeline gives it a thread).
   bool refines() const { return refiner_ != nullptr; }
   /// The recording's scans, where known: for the progress only.
@@ -106,9 +117,10 @@ class MapPass {
   std::vector<PlacedScan> refine(PlacedScan placed);
   /// The end of the input (or a stop): the last stretch refined (nothing the second time).
   std::vector<PlacedScan> finish_refinement();
-  /// The loop closure sees the scan; its rays are made. Nullopt: the run stops (the
+  /// The loop closure sees the scan; its rays are made (not with `skip_integration`: the
+  /// real-time policy's choice, its pose only goes on). Nullopt: the run stops (the
   /// relocalization gave up, or the loop thread was abandoned).
-  std::optional<LocatedScan> make_rays(PlacedScan placed);
+  std::optional<LocatedScan> make_rays(PlacedScan placed, bool skip_integration = false);
   /// Integrated into the map (the local map follows the sensor; flushed every
   /// flush_interval_s), or, without a map, its pose kept.
   void integrate(LocatedScan located);
@@ -145,6 +157,8 @@ class MapPass {
   PassResult result_;
   std::mutex warnings_mutex_;
   std::atomic<size_t> frames_read_{0};
+  std::atomic<size_t> dropped_odometry_behind_{0};
+  std::atomic<size_t> dropped_refinement_behind_{0};
   ScanLatency latency_;
   std::unique_ptr<slam::refine::PlacementRefiner> refiner_;
   std::deque<PlacedScan> held_;  ///< scans waiting for their final pose, in order

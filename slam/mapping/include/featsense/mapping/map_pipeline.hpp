@@ -6,6 +6,18 @@
 // flush of the store); joined by bounded queues. A full queue makes the stage before it wait,
 // so memory stays bounded however fast the reader is; a failing stage stops the others, the
 // map written so far is flushed and the error rethrown once every thread has joined.
+//
+// A live sensor cannot be made to wait. With PassSettings::real_time the odometry is kept at
+// the sensor's pace by this policy, each step counted (PassResult::real_time):
+//   1. The TSDF falls behind (its queue full): the next scans are placed but not integrated,
+//      their poses kept, until it has room again; it thus integrates every k-th scan for as
+//      long as it needs, and no rays are made for the others.
+//   2. The loop closure falls behind (8 keyframes queued): keyframes are skipped.
+//   3. The refinement falls behind: its queue (8 x queue_capacity scans) absorbs a stretch
+//      that takes long; once full, the odometry waits for it, and then step 4 drops scans.
+//   4. Last resort, the odometry falls behind (its queue of queue_capacity scans full): the
+//      oldest waiting scan is dropped unplaced, so the freshest scan is the next one placed.
+// The reader never waits, so the sensor's packets are never left in the socket buffers.
 
 #include <cstddef>
 #include <cstdint>

@@ -57,6 +57,9 @@ struct MapperSettings {
   std::optional<Eigen::Isometry3d> initial_guess;
   /// False: the poses only (odometry, refinement, loops), no store written.
   bool integrate = true;
+  /// A live sensor: map_source() keeps the odometry at its pace by the real-time policy of
+  /// map_pipeline.hpp (integrations skipped, then scans dropped, each counted).
+  bool real_time = false;
   /// The run as the map's new session: its input, format and how its poses were placed.
   SessionDescription session;
   /// Reads the input again from its start, for the second pass (and, continuing, for the

@@ -34,16 +34,39 @@ struct StageTimings {
   std::vector<double> latency_integrated_ms;
 };
 
+/// What the real-time policy (map_pipeline.hpp; a live sensor) gave up so that the odometry
+/// keeps the sensor's pace, by stage and reason.
+struct RealTimeCounts {
+  bool enabled = false;  ///< the pass ran under the policy
+  /// Whole scans dropped before the odometry, unplaced: it was still busy with earlier ones,
+  /// or the refinement held it up (its queue full).
+  size_t scans_dropped_odometry_behind = 0;
+  size_t scans_dropped_refinement_behind = 0;
+  /// Scans placed (their poses kept) but not integrated: the TSDF was behind.
+  size_t integrations_skipped = 0;
+  /// Keyframes the loop closure did not get: its thread was behind.
+  size_t keyframes_skipped = 0;
+
+  size_t scans_dropped() const {
+    return scans_dropped_odometry_behind + scans_dropped_refinement_behind;
+  }
+};
+
 struct PassResult {
-  size_t frames_read = 0;    ///< scans the source handed out
-  size_t frames_mapped = 0;  ///< scans integrated into the map (or placed, without a map)
+  size_t frames_read = 0;  ///< scans the source handed out
+  /// Scans integrated into the map (or placed, without a map); not those whose integration
+  /// the real-time policy skipped (real_time.integrations_skipped), whose poses are kept.
+  size_t frames_mapped = 0;
   size_t frames_without_pose = 0;
   size_t frames_outside_range = 0;
   size_t points = 0;  ///< rays integrated
   size_t mixed_pixels_dropped = 0;
   size_t voxels_updated = 0;
   StageTimings timings;
-  slam::Trajectory poses;  ///< the pose of every mapped scan, at its stamp
+  /// The pose of every mapped scan (and of every scan whose integration was skipped), at its
+  /// stamp.
+  slam::Trajectory poses;
+  RealTimeCounts real_time;
   /// With refinement: the locator's poses before it, and what it did.
   std::optional<slam::Trajectory> unrefined_poses;
   slam::refine::RefineCounts refine;
