@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "featsense/config/config_error.hpp"
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "featsense/slam/io/scan_writers.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
@@ -54,6 +55,14 @@ slam::SimulationRequest simulation_request(const SimulateOptions& o) {
   request.path = o.path;
   request.trajectory_file = o.trajectory_file;
   request.sensor = o.sensor;
+  if (o.format == "velodyne-pcap") {
+    // A Velodyne's packets say what it fired, so the simulator fires the same grid.
+    try {
+      request.sensor_model = slam::velodyne_firing_sensor(o.sensor, o.rate_hz);
+    } catch (const config::ConfigError& e) {
+      throw config::ConfigError(std::string("--format velodyne-pcap: ") + e.what());
+    }
+  }
   request.rate_hz = o.rate_hz;
   request.measurement.seed = o.seed;
   request.measurement.range_noise = !o.no_noise;
@@ -84,10 +93,14 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
   // Creates the folder, so it comes before the pcap.
   slam::SimulationWriter writer(o.output_dir, settings.sensor, 0.02, to_folder);
   std::unique_ptr<slam::OusterPcapRecorder> ouster;
+  std::unique_ptr<slam::VelodynePcapRecorder> velodyne;
   const std::filesystem::path pcap_path = std::filesystem::path(o.output_dir) / "recording.pcap";
   if (o.format == "ouster-pcap") {
     ouster = std::make_unique<slam::OusterPcapRecorder>(pcap_path.string(), settings.sensor);
     write_text(std::filesystem::path(o.output_dir) / "recording.json", ouster->metadata_json());
+  } else if (o.format == "velodyne-pcap") {
+    velodyne = std::make_unique<slam::VelodynePcapRecorder>(pcap_path.string(), o.sensor,
+                                                            settings.sensor.rate_hz);
   }
   Progress progress("frames", frames, context.quiet);
   std::vector<double> frame_ms;
@@ -104,6 +117,7 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
             .count());
     writer.add(frame, trajectory->pose(frame.start_s));
     if (ouster) ouster->add(frame.scan);
+    if (velodyne) velodyne->add(frame.scan);
     progress.update(i + 1);
   }
   writer.finish(mesh);
@@ -111,6 +125,10 @@ void run_simulate(const SimulateOptions& o, const CliContext& context) {
     ouster->finish();
     spdlog::info("{}: {} lidar and {} IMU packets (metadata in recording.json)", pcap_path.string(),
                  ouster->lidar_packets(), ouster->imu_packets());
+  }
+  if (velodyne) {
+    velodyne->finish();
+    spdlog::info("{}: {} Velodyne data packets", pcap_path.string(), velodyne->packets());
   }
   progress.finish();
   std::sort(frame_ms.begin(), frame_ms.end());
@@ -161,10 +179,11 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   command
       ->add_option("--format", o->format,
-                   "What the frames are written as: folder (sequence.yaml and PCD frames), or "
+                   "What the frames are written as: folder (sequence.yaml and PCD frames), "
                    "ouster-pcap (recording.pcap of an Ouster's lidar and IMU packets, with its "
-                   "metadata in recording.json)")
-      ->check(CLI::IsMember({"folder", "ouster-pcap"}))
+                   "metadata in recording.json), or velodyne-pcap (recording.pcap of a "
+                   "Velodyne's data packets; --sensor hdl32, vlp32c or vlp16)")
+      ->check(CLI::IsMember({"folder", "ouster-pcap", "velodyne-pcap"}))
       ->capture_default_str();
   command->add_option("--threads", o->threads, "Worker threads (default: all cores)")
       ->check(CLI::PositiveNumber);

@@ -28,8 +28,10 @@ struct SimulateOptions {
   bool no_dropouts = false;
   bool no_mixed_pixels = false;
   int threads = 0;  ///< 0: all cores
-  /// What the frames are written as: "folder" (sequence.yaml + PCD frames + imu.csv), or
-  /// "ouster-pcap" (recording.pcap of the sensor's packets + recording.json, its metadata).
+  /// What the frames are written as: "folder" (sequence.yaml + PCD frames + imu.csv),
+  /// "ouster-pcap" (recording.pcap of the sensor's packets + recording.json, its metadata), or
+  /// "velodyne-pcap" (recording.pcap of the data packets of the Velodyne preset `sensor`,
+  /// which then fires its own grid: velodyne_firing_sensor).
   std::string format = "folder";
 };
 

@@ -135,5 +135,33 @@ TEST(CliSimulate, BadInputGivesClearErrors) {
   expect_error("--scene lab --frames 100000" + out, "room for");
 }
 
+TEST(CliSimulate, VelodynePacketsReadBackOneScanPerRevolution) {
+  const auto dir = scratch_dir("cli_simulate_velodyne");
+  const std::string out = (dir / "vlp32c").string();
+  const CommandResult sim = run_featsense(
+      "simulate --quiet --scene lab --frames 2 --format velodyne-pcap --sensor vlp32c -o " + out);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  for (const char* name : {"recording.pcap", "gt_trajectory.tum", "gt_mesh.ply"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "vlp32c" / name)) << name;
+  EXPECT_FALSE(std::filesystem::exists(dir / "vlp32c" / "sequence.yaml"));  // no frame files
+  EXPECT_EQ(count_lines(dir / "vlp32c" / "gt_trajectory.tum"), 2u);
+  // The simulated revolutions start at the reader's scan cut, so each is one scan of the
+  // reader's grid (the preset's 1900 columns hold the 1808 firings of a turn at 10 Hz);
+  // test_pcap_recorders_velodyne.cpp checks each point.
+  const CommandResult info = run_featsense("info --quiet --json - " + out + "/recording.pcap");
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json j = nlohmann::json::parse(info.output);
+  EXPECT_EQ(j["format"], "velodyne-pcap");
+  EXPECT_NE(j["detail"].get<std::string>().find("VLP-32C (product id 0x28)"), std::string::npos);
+  EXPECT_EQ(j["frames"], 2);
+  EXPECT_EQ(j["rows"], 32);
+  EXPECT_EQ(j["cols"], 1900);
+  EXPECT_GT(j["valid_points"]["min"].get<int>(), 32 * 1808 / 2);  // a closed room
+  EXPECT_EQ(j["warnings"], 0);
+  // Only a Velodyne's packets are written so.
+  expect_error("--scene lab --frames 1 --format velodyne-pcap --sensor os1-128 -o " + out,
+               "'os1-128' is no Velodyne sensor");
+}
+
 }  // namespace
 }  // namespace featsense::test

@@ -85,7 +85,7 @@ PreparedSimulation::PreparedSimulation(SimulationRequest request) {
   mesh = builtin ? build_scene(request.scene) : std::move(*request.scene_mesh);
   SimulationSettings settings;
   trajectory = with_stop(make_trajectory(request, builtin, &settings.start_stamp_ns), request);
-  settings.sensor = sensor_model(request.sensor);
+  settings.sensor = request.sensor_model ? *request.sensor_model : sensor_model(request.sensor);
   if (request.rate_hz > 0.0) settings.sensor.rate_hz = request.rate_hz;
   settings.measurement = request.measurement;
 

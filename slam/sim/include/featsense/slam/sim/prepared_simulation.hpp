@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "featsense/config/sensor_model.hpp"
 #include "featsense/mesh/triangle_mesh.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/measurement_model.hpp"
@@ -24,8 +25,12 @@ struct SimulationRequest {
   /// A named path of the built-in scene (walk, drive, drone, loop); empty: walk, unless
   /// `trajectory_file` is given.
   std::string path;
-  std::string trajectory_file;      ///< TUM sensor poses (map <- sensor) instead of `path`
-  std::string sensor = "os1-128";   ///< a preset, or an Ouster metadata .json
+  std::string trajectory_file;     ///< TUM sensor poses (map <- sensor) instead of `path`
+  std::string sensor = "os1-128";  ///< a preset, or an Ouster metadata .json
+  /// The sensor itself, where it is made rather than named (the firing grid of a Velodyne
+  /// whose packets are written: velodyne_firing_sensor); set, `sensor` is not read. Such a
+  /// model holds for its rate: leave rate_hz 0 or at that rate.
+  std::optional<config::SensorModel> sensor_model;
   double rate_hz = 0.0;             ///< revolutions per second; 0: the sensor's
   MeasurementSettings measurement;  ///< noise, intensity, drop-outs, mixed pixels
   int frames = 0;                   ///< 0: as many as the path holds
