@@ -11,7 +11,9 @@
 #include "commands.hpp"
 #include "featsense/mapping/recording.hpp"
 #include "featsense/slam/io/live_source.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "map_job.hpp"
+#include "map_outputs.hpp"
 #include "ouster_metadata_fetch.hpp"
 #include "stop_signal.hpp"
 
@@ -46,6 +48,7 @@ void run_live(LiveCommandOptions& options, const CliContext& context) {
   options.live.sensor =
       options.sensor == "velodyne" ? slam::LiveSensor::kVelodyne : slam::LiveSensor::kOuster;
   const config::Config config = map_config(options.map, context);
+  options.map.real_time = true;
   const StopSignal stop_signal(StopSignal::kMapMessage);
   options.live.stop_requested = [&stop_signal] { return stop_signal.requested(); };
   options.live.on_listening = [&context](const std::string& address) {
@@ -55,9 +58,17 @@ void run_live(LiveCommandOptions& options, const CliContext& context) {
   };
   std::unique_ptr<slam::ScanSource> source = slam::open_live_source(
       options.live, mapping::source_options(config, metadata_path(options), std::nullopt));
+  // A dry run with a known path and surface (a simulated recording replayed) is evaluated as
+  // `map` evaluates one: the estimate aligned to the truth.
+  std::optional<KnownTrajectory> truth;
+  if (options.map.reference_trajectory) {
+    truth = KnownTrajectory{slam::read_trajectory(*options.map.reference_trajectory, "auto", {}),
+                            false};
+  }
+  const MeshReferences references = find_mesh_references("", options.map.reference);
   // No second pass after loop closures: what the sensor sent cannot be read again.
   try {
-    map_recording(*source, std::nullopt, std::nullopt, options.map, config, {}, context, {},
+    map_recording(*source, std::nullopt, truth, options.map, config, references, context, {},
                   &stop_signal);
   } catch (const Interrupted&) {
     if (!stop_signal.requested()) throw;  // Ctrl+C after scans: handled below
@@ -116,6 +127,15 @@ Command register_live(CLI::App& app, const CliContext& context) {
                    "End the run after this many seconds without a packet (0: only Ctrl+C)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      ->add_option("--reference-trajectory", options->map.reference_trajectory,
+                   "A dry run's true path (TUM or KITTI), to compare the poses with in "
+                   "report.json (a simulated recording's gt_trajectory.tum)")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--reference", options->map.reference,
+                   "A dry run's true surface, to evaluate the mesh against (gt_mesh.ply)")
+      ->check(CLI::ExistingFile);
   add_config_option(*command, kBackendOption, options->map.backend);
   add_map_output_flags(*command, options->map);
   return {command, [options, &context] { run_live(*options, context); }};

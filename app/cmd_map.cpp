@@ -150,6 +150,7 @@ mapping::MapperSettings mapper_settings(const slam::SourceInfo& info,
                                         const MapOptions& options, config::Config config,
                                         const SourceReopener& reopen) {
   mapping::MapperSettings settings;
+  settings.real_time = options.real_time;
   settings.config = std::move(config);
   settings.sensor = info.sensor;
   settings.map_path = fs::path(options.output) / "map.h5";
@@ -328,6 +329,13 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     std::printf("%zu scans mapped in %.1f s (%.1f scans/s, %s), %zu chunks, %zu shifts -> %s\n",
                 mapped.frames_mapped, mapped.wall_s, mapped.scans_per_s(), mapped.backend.c_str(),
                 mapped.map_chunks, mapped.map.shifts, out.string().c_str());
+    const mapping::RealTimeCounts& kept_up = mapped.real_time;
+    if (kept_up.scans_dropped() + kept_up.integrations_skipped + kept_up.keyframes_skipped > 0) {
+      std::printf(
+          "to keep up: %zu integrations skipped (poses kept), %zu scans dropped, %zu "
+          "keyframes skipped\n",
+          kept_up.integrations_skipped, kept_up.scans_dropped(), kept_up.keyframes_skipped);
+    }
   }
   return {out, report};
 }

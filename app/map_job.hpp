@@ -38,6 +38,7 @@ struct MapOptions {
   bool no_loop_closure = false;  ///< loop.enabled false
   bool poses_only = false;       ///< the poses and the report, no map
   bool print_summary = true;     ///< the one-line summary on stdout
+  bool real_time = false;        ///< a live sensor: the pipeline's real-time policy
 };
 
 struct MapOutcome {

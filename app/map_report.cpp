@@ -29,6 +29,13 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
   report["frames_skipped"] = {{"without_pose", run.frames_without_pose},
                               {"outside_range", run.frames_outside_range}};
   report["interrupted"] = run.interrupted;
+  // What the real-time policy of a live run gave up to keep the sensor's pace, by stage.
+  report["real_time"] = {{"enabled", run.real_time.enabled},
+                         {"scans_dropped",
+                          {{"odometry_behind", run.real_time.scans_dropped_odometry_behind},
+                           {"refinement_behind", run.real_time.scans_dropped_refinement_behind}}},
+                         {"integrations_skipped", run.real_time.integrations_skipped},
+                         {"keyframes_skipped", run.real_time.keyframes_skipped}};
   report["backend"] = run.backend;
   report["backend_reason"] = run.backend_reason;
   report["poses"] = result.poses;
