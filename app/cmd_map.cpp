@@ -266,7 +266,16 @@ std::optional<Eigen::Isometry3d> add_trajectory_evaluation(
     series.rotation_fixed = spans_plane;
     report["eval"]["traj"]["error_files"] = write_trajectory_error_png(
         out, series, report.contains("loops") ? report["loops"] : nlohmann::json::object());
-    if (result.odometry && spans_plane) T_truth_estimate = final_evaluation.alignment.T;
+    // The mesh lies in the frame of the poses it was made with: after a second pass the final
+    // ones, else (a live run, an interrupted one) the first pass's, before the loops' and
+    // gravity's corrections.
+    if (result.odometry && spans_plane) {
+      const slam::Trajectory& mapped_poses = result.mapped().poses;
+      T_truth_estimate =
+          mapped_poses.size() < 2
+              ? final_evaluation.alignment.T
+              : slam::evaluate_trajectory(mapped_poses, truth->poses, eval_settings).alignment.T;
+    }
     // The front end's own poses too, to show what the loops and the refinement changed.
     const std::optional<mapping::LoopOutcome>& loops = result.first.loops;
     if (loops && loops->corrects_poses())

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "background_thread.hpp"
 #include "featsense/slam/refine/refinement_cloud.hpp"
 
 namespace featsense::mapping {
@@ -40,6 +41,15 @@ LoopStage::~LoopStage() {
 }
 
 void LoopStage::work() {
+  if (never_wait_) {
+    // Real time: below the odometry (background_thread.hpp), like the other lagging stages.
+    BackgroundThread(kBackgroundNice).run([this] { take_keyframes(); });
+  } else {
+    take_keyframes();
+  }
+}
+
+void LoopStage::take_keyframes() {
   try {
     while (std::optional<KeyframeJob> job = queue_.pop()) {
       closer_.add_keyframe(job->stamp_ns, job->travelled_m, job->T_map_sensor, job->points);

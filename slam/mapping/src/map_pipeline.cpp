@@ -7,6 +7,7 @@
 #include <thread>
 #include <utility>
 
+#include "background_thread.hpp"
 #include "featsense/mapping/bounded_queue.hpp"
 
 namespace featsense::mapping {
@@ -47,6 +48,14 @@ void guarded(PipelineState& state, const Work& work) {
   } catch (...) {
     state.fail(std::current_exception());
   }
+}
+
+/// guarded(), below the odometry in real time (background_thread.hpp); call it on the stage's
+/// own thread.
+template <typename Work>
+void guarded_stage(PipelineState& state, bool real_time, int nice_increment, const Work& work) {
+  if (!real_time) return guarded(state, work);
+  guarded(state, [&] { BackgroundThread(nice_increment).run(work); });
 }
 
 bool before_range(const slam::Scan& scan, const FrameRange& range, int64_t first_stamp_ns) {
@@ -156,10 +165,14 @@ void drive_pass(slam::ScanSource& source, MapPass& pass, const PipelineSettings&
   BoundedQueue<slam::Scan> scans(settings.queue_capacity);
   // Before a refinement the odometry runs ahead while a stretch is registered: a deeper queue,
   // deeper still in real time, where the odometry must not wait for a stretch that takes long.
-  const size_t refine_depth = (pass.real_time() ? 8 : 4) * settings.queue_capacity;
+  const bool real_time = pass.real_time();
+  const size_t refine_depth = (real_time ? 16 : 4) * settings.queue_capacity;
   BoundedQueue<PlacedScan> placed(pass.refines() ? refine_depth : settings.queue_capacity);
   BoundedQueue<PlacedScan> refined(settings.queue_capacity);
-  BoundedQueue<LocatedScan> located(settings.queue_capacity);
+  // Real time: the refinement hands out a stretch's scans at once, and the map pauses for its
+  // shifts and flushes; a deeper queue rides those out, so that only a TSDF that is really
+  // behind has integrations skipped.
+  BoundedQueue<LocatedScan> located((real_time ? 4 : 1) * settings.queue_capacity);
 
   // Each stage closes its output when it ends, so the next one drains and ends too; a
   // failing stage abandons its input so the one before it cannot block on a full queue.
@@ -175,18 +188,27 @@ void drive_pass(slam::ScanSource& source, MapPass& pass, const PipelineSettings&
   std::thread refinement;
   if (pass.refines()) {
     refinement = std::thread([&] {
-      guarded(state, [&] { refine_scans(pass, placed, refined); });
+      guarded_stage(state, real_time, kRefinementNice,
+                    [&] { refine_scans(pass, placed, refined); });
       if (state.stopping()) placed.abandon();
       refined.close();
     });
   }
   BoundedQueue<PlacedScan>& to_rays = pass.refines() ? refined : placed;
   std::thread rays([&] {
-    guarded(state, [&] { make_rays(pass, to_rays, located); });
+    guarded_stage(state, real_time, kBackgroundNice, [&] { make_rays(pass, to_rays, located); });
     if (state.stopping()) to_rays.abandon();
     located.close();
   });
-  guarded(state, [&] { integrate_scans(pass, located); });
+  if (real_time) {
+    // On a thread of its own, whose lowered priority ends with it.
+    std::thread mapping([&] {
+      guarded_stage(state, true, kBackgroundNice, [&] { integrate_scans(pass, located); });
+    });
+    mapping.join();
+  } else {
+    guarded(state, [&] { integrate_scans(pass, located); });
+  }
   located.abandon();
   refined.abandon();
   placed.abandon();

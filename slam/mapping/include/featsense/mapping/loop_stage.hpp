@@ -94,6 +94,7 @@ class LoopStage {
     size_t scan = 0;  ///< how many scans were offered before it
   };
   void work();
+  void take_keyframes();
 
   slam::loops::LoopSettings settings_;
   slam::loops::KeyframeSelector selector_;

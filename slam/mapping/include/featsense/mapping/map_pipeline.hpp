@@ -8,12 +8,17 @@
 // map written so far is flushed and the error rethrown once every thread has joined.
 //
 // A live sensor cannot be made to wait. With PassSettings::real_time the odometry is kept at
-// the sensor's pace by this policy, each step counted (PassResult::real_time):
-//   1. The TSDF falls behind (its queue full): the next scans are placed but not integrated,
+// the sensor's pace. The stages after it run below it (background_thread.hpp: lower thread
+// priorities, and parallel loops that leave a core to the odometry; the TSDF then on a
+// thread of its own), and this policy decides what they give up, each step counted
+// (PassResult::real_time):
+//   1. The TSDF falls behind (its queue of 4 x queue_capacity scans full, deep enough for a
+//      refined stretch handed out at once and a map shift): the next scans are placed but not
+//      integrated,
 //      their poses kept, until it has room again; it thus integrates every k-th scan for as
 //      long as it needs, and no rays are made for the others.
 //   2. The loop closure falls behind (8 keyframes queued): keyframes are skipped.
-//   3. The refinement falls behind: its queue (8 x queue_capacity scans) absorbs a stretch
+//   3. The refinement falls behind: its queue (16 x queue_capacity scans) absorbs a stretch
 //      that takes long; once full, the odometry waits for it, and then step 4 drops scans.
 //   4. Last resort, the odometry falls behind (its queue of queue_capacity scans full): the
 //      oldest waiting scan is dropped unplaced, so the freshest scan is the next one placed.
