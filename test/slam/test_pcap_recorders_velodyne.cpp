@@ -13,6 +13,7 @@
 #include "featsense/slam/io/open_scan_source.hpp"
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
+#include "pcap_test_util.hpp"
 #include "sim_test_util.hpp"
 #include "velodyne/velodyne_firing.hpp"
 #include "velodyne/velodyne_firing_geometry.hpp"
@@ -286,6 +287,61 @@ TEST(VelodynePcapRecorder, WhatIsNoWritableVelodyneIsRefused) {
   EXPECT_THROW(recorder.add(Scan::allocate(32, 1800)), std::invalid_argument);
   EXPECT_THROW(VelodynePcapRecorder("/nonexistent-folder/x.pcap", "hdl32"), WriteError);
   fs::remove(path);
+}
+
+/// The scans of a pcap and its reader's warnings.
+std::pair<std::vector<Scan>, ReadStats> read_pcap(const fs::path& path) {
+  SourceOptions options;
+  options.min_range_m = 0.0;
+  const auto source = open_scan_source(path.string(), options);
+  std::vector<Scan> scans;
+  while (auto scan = source->next()) scans.push_back(std::move(*scan));
+  return {std::move(scans), source->stats()};
+}
+
+TEST(VelodynePcapRecorder, OtherDatagramsOnTheDataPortAreCountedPositionPacketsNot) {
+  const test::Box box;
+  const mesh::TriangleMesh mesh = test::box_mesh(box);
+  const RayCaster caster(mesh);
+  const auto trajectory =
+      make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+  SimulationSettings settings;
+  settings.sensor = velodyne_firing_sensor("hdl32", 10.0);
+  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
+  const fs::path dir = fs::temp_directory_path() / "featsense_velodyne_foreign_datagrams";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    VelodynePcapRecorder recorder((dir / "clean.pcap").string(), "hdl32", 10.0);
+    for (uint64_t i = 0; i < 2; ++i) recorder.add(simulator.simulate(i).scan);
+    recorder.finish();
+  }
+  // Among the data packets: position packets on 8308 (as every Velodyne sends), three
+  // datagrams of another size on the data port and one on another port.
+  std::vector<test::CapturedFrame> frames =
+      test::read_pcap_frames(test::read_file(dir / "clean.pcap"));
+  ASSERT_GT(frames.size(), 100u);
+  const auto extra = [&](size_t at, size_t bytes, uint16_t port) {
+    test::CapturedFrame frame = frames[at];
+    frame.bytes = test::ethernet_ipv4_udp(std::vector<uint8_t>(bytes, 0x5A), port, 9000);
+    frames.insert(frames.begin() + static_cast<std::ptrdiff_t>(at), frame);
+  };
+  for (size_t at : {5, 40, 80}) extra(at, 512, 8308);
+  for (size_t at : {20, 60}) extra(at, 100, 2368);
+  extra(70, 1248, 2368);
+  extra(90, 300, 5000);
+  test::write_file(dir / "mixed.pcap", test::write_pcap(frames));
+
+  const auto [clean, clean_stats] = read_pcap(dir / "clean.pcap");
+  const auto [mixed, mixed_stats] = read_pcap(dir / "mixed.pcap");
+  fs::remove_all(dir);
+  ASSERT_EQ(clean_stats.warning_count, 0u);
+  ASSERT_EQ(mixed.size(), clean.size());
+  for (size_t i = 0; i < clean.size(); ++i) EXPECT_EQ(mixed[i].valid, clean[i].valid) << i;
+  ASSERT_EQ(mixed_stats.warning_count, 1u);
+  const std::string& warning = mixed_stats.warnings.front();
+  EXPECT_NE(warning.find("3 datagrams on the data port 2368"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("2 of 100 bytes, 1 of 1248 bytes"), std::string::npos) << warning;
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 // packets of 1206 bytes (port 2368 by default; position packets of 512 bytes on 8308 and
 // anything else are passed over), read as a stream of scans.
 
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "featsense/slam/io/readers.hpp"
@@ -14,6 +17,8 @@ namespace {
 
 /// UDP datagrams looked at to tell a Velodyne capture from an Ouster one.
 constexpr size_t kProbeDatagrams = 64;
+/// A position packet (GPS time and NMEA sentence, port 8308): not data, passed over.
+constexpr size_t kVelodynePositionPacketBytes = 512;
 
 /// A Velodyne sensor's data packets, from a pcap file or from the network.
 class VelodynePacketSource final : public ScanSource {
@@ -41,6 +46,7 @@ class VelodynePacketSource final : public ScanSource {
       if (!datagram) {
         done_ = true;
         for (const std::string& warning : feed_->end_warnings()) warn(warning);
+        if (foreign_datagrams_ > 0) warn(foreign_datagrams_message());
         if (assembler_.decoder().bad_blocks() > 0) {
           warn(std::to_string(assembler_.decoder().bad_blocks()) +
                " Velodyne data blocks with a flag or azimuth the model does not use; skipped");
@@ -48,7 +54,11 @@ class VelodynePacketSource final : public ScanSource {
         assembler_.flush();
         continue;
       }
-      if (datagram->size != kVelodynePacketBytes) continue;
+      if (datagram->size != kVelodynePacketBytes) {
+        count_other(*datagram);
+        continue;
+      }
+      if (!data_port_) data_port_ = datagram->destination_port;
       assembler_.add_packet(datagram->payload, datagram->timestamp_ns);
     }
   }
@@ -56,10 +66,36 @@ class VelodynePacketSource final : public ScanSource {
   const SourceInfo& info() const override { return info_; }
 
  private:
+  /// A datagram of another size on the data packets' port (a second sensor of another kind,
+  /// a wrong port setting) is counted; position packets and other ports' traffic are not.
+  void count_other(const detail::UdpDatagram& datagram) {
+    if (datagram.size == kVelodynePositionPacketBytes || !data_port_ ||
+        datagram.destination_port != *data_port_) {
+      return;
+    }
+    ++foreign_datagrams_;
+    ++foreign_sizes_[datagram.size];
+  }
+
+  std::string foreign_datagrams_message() const {
+    std::string sizes;
+    for (const auto& [size, count] : foreign_sizes_) {
+      if (!sizes.empty()) sizes += ", ";
+      sizes += std::to_string(count) + " of " + std::to_string(size) + " bytes";
+      if (sizes.size() > 200) break;
+    }
+    return feed_->origin() + ": " + std::to_string(foreign_datagrams_) +
+           " datagrams on the data port " + std::to_string(*data_port_) +
+           " were no Velodyne data packets (" + sizes + "); skipped";
+  }
+
   SourceInfo info_;
   std::unique_ptr<detail::DatagramFeed> feed_;
   VelodyneScanAssembler assembler_;
   bool done_ = false;
+  std::optional<uint16_t> data_port_;  ///< where the first data packet came
+  size_t foreign_datagrams_ = 0;
+  std::map<size_t, size_t> foreign_sizes_;
 };
 
 /// The first Velodyne data packet among the first datagrams, if any.
