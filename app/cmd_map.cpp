@@ -42,10 +42,13 @@ slam::Trajectory read_poses(const MapOptions& options) {
   return slam::read_trajectory(*options.gt, options.gt_format, options.gt_times);
 }
 
-/// The ground truth of a simulated recording (gt_trajectory.tum in its folder), if any.
+/// The ground truth of a simulated recording (gt_trajectory.tum in its folder, or beside a
+/// simulated pcap), if any.
 std::optional<KnownTrajectory> ground_truth_beside(const slam::SourceInfo& info) {
-  const fs::path file = fs::path(info.path) / "gt_trajectory.tum";
-  if (!fs::is_directory(info.path) || !fs::is_regular_file(file)) return std::nullopt;
+  const std::optional<fs::path> folder = simulation_truth_folder(info.path);
+  if (!folder) return std::nullopt;
+  const fs::path file = *folder / "gt_trajectory.tum";
+  if (!fs::is_regular_file(file)) return std::nullopt;
   try {
     return KnownTrajectory{slam::read_tum(file.string()), true};
   } catch (const slam::TrajectoryError& e) {

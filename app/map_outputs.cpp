@@ -80,6 +80,21 @@ nlohmann::json plan_json(const viewer_export::PlanView& plan, const std::string&
           {"cut_high_m", height(plan.cut_high_m)}};
 }
 
+std::optional<fs::path> simulation_truth_folder(const std::string& input) {
+  if (input.empty()) return std::nullopt;
+  const fs::path path(input);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return path;
+  // A pcap alone in a folder with the simulator's truth: both files, so that a capture of
+  // one's own kept beside some other trajectory is not taken for a simulation.
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (path.extension() == ".pcap" && fs::is_regular_file(folder / "gt_trajectory.tum", ec) &&
+      fs::is_regular_file(folder / "gt_mesh.ply", ec)) {
+    return folder;
+  }
+  return std::nullopt;
+}
+
 MeshReferences find_mesh_references(const std::string& input,
                                     const std::optional<std::string>& user_reference) {
   MeshReferences references;
@@ -87,10 +102,10 @@ MeshReferences find_mesh_references(const std::string& input,
     references.surface = fs::path(*user_reference);
     return references;
   }
-  const fs::path folder(input);
-  if (fs::is_directory(folder) && fs::is_regular_file(folder / "gt_mesh.ply")) {
-    references.surface = folder / "gt_mesh.ply";
-    if (fs::is_regular_file(folder / "gt_points.ply")) references.seen = folder / "gt_points.ply";
+  const std::optional<fs::path> folder = simulation_truth_folder(input);
+  if (folder && fs::is_regular_file(*folder / "gt_mesh.ply")) {
+    references.surface = *folder / "gt_mesh.ply";
+    if (fs::is_regular_file(*folder / "gt_points.ply")) references.seen = *folder / "gt_points.ply";
   }
   return references;
 }

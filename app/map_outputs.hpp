@@ -63,8 +63,13 @@ struct MeshErrorOutputs {
   PlanInputs plan;
 };
 
-/// The user's reference mesh when given; else the ground truth beside a simulated sequence
-/// (gt_mesh.ply and gt_points.ply in the INPUT folder); else none.
+/// The folder of a simulation's ground truth (gt_trajectory.tum, gt_mesh.ply) for an input:
+/// the input itself, a simulated folder; or the folder of a simulated pcap (`simulate --format
+/// ouster-pcap|velodyne-pcap` writes recording.pcap beside its truth). Nullopt otherwise.
+std::optional<std::filesystem::path> simulation_truth_folder(const std::string& input);
+
+/// The user's reference mesh when given; else the ground truth of a simulation
+/// (simulation_truth_folder: gt_mesh.ply, and gt_points.ply where there is one); else none.
 MeshReferences find_mesh_references(const std::string& input,
                                     const std::optional<std::string>& user_reference);
 

@@ -62,7 +62,7 @@ TEST(CliSimulate, OusterPacketsReadBackAsTheFolderOfTheSameRun) {
   const auto dir = scratch_dir("cli_simulate_pcap");
   const std::string pcap_out = (dir / "pcap").string();
   const std::string folder_out = (dir / "folder").string();
-  const std::string args = "simulate --quiet --scene lab --frames 2 --rate 20 --seed 4 ";
+  const std::string args = "simulate --quiet --scene lab --frames 3 --rate 20 --seed 4 ";
   const CommandResult pcap = run_featsense(args + "--format ouster-pcap -o " + pcap_out);
   ASSERT_EQ(pcap.exit_code, 0) << pcap.output;
   for (const char* name : {"recording.pcap", "recording.json", "gt_trajectory.tum", "gt_mesh.ply"})
@@ -80,11 +80,20 @@ TEST(CliSimulate, OusterPacketsReadBackAsTheFolderOfTheSameRun) {
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const nlohmann::json ja = nlohmann::json::parse(a.output);
   const nlohmann::json jb = nlohmann::json::parse(b.output);
-  EXPECT_EQ(ja["frames"], 2);
+  EXPECT_EQ(ja["frames"], 3);
   EXPECT_EQ(ja["rows"], jb["rows"]);
   EXPECT_EQ(ja["cols"], jb["cols"]);
   EXPECT_EQ(ja["valid_points"], jb["valid_points"]);
   EXPECT_EQ(ja["warnings"], 0);
+  // `map` of the pcap finds the simulation's truth beside it, as it does in a folder: the map
+  // starts at the true first pose and is scored against the true surface.
+  const CommandResult map = run_featsense("map --quiet --no-loop-closure " + pcap_out +
+                                          "/recording.pcap -o " + (dir / "map").string());
+  ASSERT_EQ(map.exit_code, 0) << map.output;
+  const nlohmann::json report = nlohmann::json::parse(file_bytes(dir / "map" / "report.json"));
+  ASSERT_TRUE(report.contains("eval")) << report.dump();
+  EXPECT_EQ(report["eval"]["traj"]["ape"]["count"], 3);
+  EXPECT_LT(report["eval"]["mesh"]["accuracy"]["median"].get<double>(), 0.05);
   // A rate that Ouster's modes cannot say is one clear error.
   const CommandResult bad = run_featsense(
       "simulate --quiet --scene lab --frames 1 --rate 12.5 --format ouster-pcap -o " + pcap_out);
