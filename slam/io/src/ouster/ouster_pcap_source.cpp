@@ -208,7 +208,7 @@ class OusterPacketSource final : public ScanSource {
     if (assembler_.incomplete_frames() > incomplete_seen_) {
       incomplete_seen_ = assembler_.incomplete_frames();
       warn(path_ + ": frame " + std::to_string(scan.sequence) +
-           " is incomplete (columns missing from the capture are marked invalid)");
+           " is incomplete (the columns whose packets did not come are marked invalid)");
     }
     count_frame();
     return scan;
