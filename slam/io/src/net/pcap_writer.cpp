@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "featsense/slam/io/scan_writers.hpp"
+#include "ouster/byte_order.hpp"
 
 namespace featsense::slam::detail {
 namespace {
@@ -15,7 +16,8 @@ constexpr uint32_t kSnapLength = 262144;
 constexpr uint32_t kLinkTypeEthernet = 1;
 
 void put_le(std::vector<uint8_t>& out, uint32_t value, size_t bytes) {
-  for (size_t i = 0; i < bytes; ++i) out.push_back(static_cast<uint8_t>(value >> (8 * i)));
+  out.resize(out.size() + bytes);
+  store_le_bytes(out.data() + out.size() - bytes, value, bytes);
 }
 
 void set_be16(std::vector<uint8_t>& b, size_t at, uint32_t value) {

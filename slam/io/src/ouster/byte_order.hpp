@@ -1,6 +1,6 @@
 #pragma once
-// Reads of unaligned integers from byte buffers in a stated byte order. Callers check the
-// bounds first; these never read past `data + sizeof(T)`.
+// Reads and writes of unaligned integers in byte buffers in a stated byte order. Callers
+// check the bounds first; these never touch more than the bytes they name.
 
 #include <cstdint>
 #include <cstring>
@@ -33,6 +33,12 @@ inline uint64_t load_le_bytes(const uint8_t* data, size_t bytes) {
   uint64_t value = 0;
   for (size_t i = 0; i < bytes && i < 8; ++i) value |= static_cast<uint64_t>(data[i]) << (8 * i);
   return value;
+}
+
+/// Writes the low `bytes` (<= 8) bytes of `value` little-endian at `data`: load_le_bytes's
+/// inverse, for the packet and capture writers.
+inline void store_le_bytes(uint8_t* data, uint64_t value, size_t bytes) {
+  for (size_t i = 0; i < bytes && i < 8; ++i) data[i] = static_cast<uint8_t>(value >> (8 * i));
 }
 
 /// Byte-swaps a 32-bit value (pcap files written on big-endian hosts).

@@ -11,9 +11,12 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "net/pcap_writer.hpp"
+#include "ouster/byte_order.hpp"
 
 namespace featsense::slam {
 namespace {
+
+using detail::store_le_bytes;
 
 constexpr int kColumnsPerPacket = 16;
 constexpr size_t kHeaderBytes = 32;
@@ -30,15 +33,11 @@ constexpr double kStandardGravity = 9.80665;  // m/s^2 per g, as the reader divi
 constexpr uint64_t kSerial = 990000000001ull;
 constexpr uint64_t kInitializationId = 7109750;
 
-void put(uint8_t* at, uint64_t value, size_t bytes) {
-  for (size_t i = 0; i < bytes; ++i) at[i] = static_cast<uint8_t>(value >> (8 * i));
-}
-
 void put_float(uint8_t* at, double value) {
   const float f = static_cast<float>(value);
   uint32_t bits = 0;
   std::memcpy(&bits, &f, sizeof bits);
-  put(at, bits, 4);
+  store_le_bytes(at, bits, 4);
 }
 
 /// "os1-128" -> "OS-1-128", Ouster's way of writing a product line; other names as they are.
@@ -174,7 +173,8 @@ void OusterPcapRecorder::add(const Scan& scan) {
       // A sample at the instant where one sweep ends and the next begins may come with both.
       if (st.imu_written && sample.stamp_ns <= st.last_imu_stamp_ns) continue;
       uint8_t imu[kImuPacketBytes] = {};
-      for (size_t k = 0; k < 3; ++k) put(imu + 8 * k, static_cast<uint64_t>(sample.stamp_ns), 8);
+      for (size_t k = 0; k < 3; ++k)
+        store_le_bytes(imu + 8 * k, static_cast<uint64_t>(sample.stamp_ns), 8);
       for (int k = 0; k < 3; ++k) {
         put_float(imu + 24 + 4 * k, sample.accel_mps2[k] / kStandardGravity);
         put_float(imu + 36 + 4 * k, sample.gyro_radps[k] * 180.0 / M_PI);
@@ -189,36 +189,36 @@ void OusterPcapRecorder::add(const Scan& scan) {
   for (int first = 0; first < s.columns; first += kColumnsPerPacket) {
     st.packet.assign(packet_bytes, 0);
     uint8_t* p = st.packet.data();
-    put(p, kLidarDataPacketType, 2);
-    put(p + 2, st.frame_id, 2);
-    put(p + 4, kInitializationId, 3);
-    put(p + 7, kSerial, 5);
+    store_le_bytes(p, kLidarDataPacketType, 2);
+    store_le_bytes(p + 2, st.frame_id, 2);
+    store_le_bytes(p + 4, kInitializationId, 3);
+    store_le_bytes(p + 7, kSerial, 5);
     int64_t sent_ns = 0;
     for (int k = 0; k < kColumnsPerPacket; ++k) {
       const int c = first + k;
       uint8_t* column = p + kHeaderBytes + static_cast<size_t>(k) * column_bytes;
       if (c >= s.columns) {  // past the frame's last column: a column marked invalid
-        put(column + 8, static_cast<uint64_t>(s.columns), 2);
+        store_le_bytes(column + 8, static_cast<uint64_t>(s.columns), 2);
         continue;
       }
       const int64_t t = column_ns[static_cast<size_t>(c)];
       sent_ns = t;
-      put(column, static_cast<uint64_t>(t), 8);
-      put(column + 8, static_cast<uint64_t>(c), 2);
-      put(column + 10, 1, 2);  // status: valid
+      store_le_bytes(column, static_cast<uint64_t>(t), 8);
+      store_le_bytes(column + 8, static_cast<uint64_t>(c), 2);
+      store_le_bytes(column + 10, 1, 2);  // status: valid
       for (int row = 0; row < s.beams; ++row) {
         const size_t i = scan.index(row, c);
         uint8_t* pixel = column + kColumnHeaderBytes + static_cast<size_t>(row) * kPixelBytes;
         const double range_mm = std::round(static_cast<double>(scan.range_m[i]) * 1000.0);
         if (scan.valid[i] && range_mm > 0.0 && range_mm <= kMaxRangeMm) {
-          put(pixel, static_cast<uint32_t>(range_mm), 4);
+          store_le_bytes(pixel, static_cast<uint32_t>(range_mm), 4);
         }
         if (reflectivity != nullptr) {
           const float v = reflectivity->values[i];
           pixel[4] = v > 0.0f ? static_cast<uint8_t>(std::min(255.0f, std::round(v))) : 0;
         }
-        if (signal != nullptr) put(pixel + 6, clamp_u16(signal->values[i]), 2);
-        if (nir != nullptr) put(pixel + 8, clamp_u16(nir->values[i]), 2);
+        if (signal != nullptr) store_le_bytes(pixel + 6, clamp_u16(signal->values[i]), 2);
+        if (nir != nullptr) store_le_bytes(pixel + 8, clamp_u16(nir->values[i]), 2);
       }
     }
     send_imu_until(sent_ns);

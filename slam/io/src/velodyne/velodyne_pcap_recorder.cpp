@@ -12,10 +12,13 @@
 
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "net/pcap_writer.hpp"
+#include "ouster/byte_order.hpp"
 #include "velodyne/velodyne_firing_geometry.hpp"
 
 namespace featsense::slam {
 namespace {
+
+using detail::store_le_bytes;
 
 constexpr uint16_t kDataPort = 2368;
 constexpr size_t kTimeStampByte = 1200;
@@ -35,10 +38,6 @@ uint8_t product_id(VelodyneModel model) {
       break;
   }
   return 0;
-}
-
-void put(uint8_t* at, uint64_t value, size_t bytes) {
-  for (size_t i = 0; i < bytes; ++i) at[i] = static_cast<uint8_t>(value >> (8 * i));
 }
 
 }  // namespace
@@ -75,12 +74,12 @@ void VelodynePcapRecorder::State::fire(const Scan* scan, int c, int64_t column, 
   if (sequence == 0) {
     block[0] = 0xFF;  // the flag of the upper (only) bank, FF EE
     block[1] = 0xEE;
-    put(block + 2, geometry.azimuth_centideg(column), 2);
+    store_le_bytes(block + 2, geometry.azimuth_centideg(column), 2);
   }
   if (firings == 0) {
     // Microseconds past the full hour of the sensor's clock, of the packet's first firing.
     const int64_t us = (time_ns + 500) / 1000;
-    put(packet.data() + kTimeStampByte, static_cast<uint64_t>(us % kHourUs), 4);
+    store_le_bytes(packet.data() + kTimeStampByte, static_cast<uint64_t>(us % kHourUs), 4);
   }
   if (scan != nullptr) {
     const ScanChannel* reflectivity = scan->intensity();  // reflectivity where there is one
@@ -92,7 +91,7 @@ void VelodynePcapRecorder::State::fire(const Scan* scan, int c, int64_t column, 
       uint8_t* ret = block + 4 + slot * 3;
       const double units = std::round(scan->range_m[i] / distance_unit_m);
       if (!scan->valid[i] || units < 1.0 || units > 65535.0) continue;  // 0: no return
-      put(ret, static_cast<uint64_t>(units), 2);
+      store_le_bytes(ret, static_cast<uint64_t>(units), 2);
       const float v = reflectivity != nullptr ? reflectivity->values[i] : 0.0f;
       ret[2] = v > 0.0f ? static_cast<uint8_t>(std::min(255.0f, std::round(v))) : 0;
     }
