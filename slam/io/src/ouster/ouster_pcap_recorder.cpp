@@ -12,6 +12,8 @@
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "net/pcap_writer.hpp"
 #include "ouster/byte_order.hpp"
+#include "ouster/ouster_imu_packet.hpp"
+#include "ouster/ouster_packet.hpp"
 
 namespace featsense::slam {
 namespace {
@@ -19,11 +21,7 @@ namespace {
 using detail::store_le_bytes;
 
 constexpr int kColumnsPerPacket = 16;
-constexpr size_t kHeaderBytes = 32;
-constexpr size_t kFooterBytes = 32;
-constexpr size_t kColumnHeaderBytes = 12;
-constexpr size_t kPixelBytes = 12;
-constexpr size_t kImuPacketBytes = 48;
+using detail::kOusterImuPacketBytes;
 constexpr uint32_t kMaxRangeMm = (1u << 19) - 1;
 constexpr uint16_t kLidarDataPacketType = 1;
 constexpr uint16_t kLidarPort = 7502;
@@ -52,6 +50,15 @@ std::string product_line(const std::string& name) {
   return name;
 }
 
+/// The byte layout of the packets written: the reader's for the profile and geometry.
+detail::OusterPacketLayout packet_layout(const config::SensorModel& sensor) {
+  OusterMetadata metadata;
+  metadata.profile = OusterProfile::kRng19Rfl8Sig16Nir16;
+  metadata.pixels_per_column = sensor.beams;
+  metadata.columns_per_packet = kColumnsPerPacket;
+  return detail::OusterPacketLayout::of(metadata);
+}
+
 uint16_t clamp_u16(float value) {
   if (!(value > 0.0f)) return 0;
   return static_cast<uint16_t>(std::min(65535.0f, std::round(value)));
@@ -60,9 +67,11 @@ uint16_t clamp_u16(float value) {
 }  // namespace
 
 struct OusterPcapRecorder::State {
-  State(const std::string& path, config::SensorModel s) : sensor(std::move(s)), pcap(path) {}
+  State(const std::string& path, config::SensorModel s)
+      : sensor(std::move(s)), layout(packet_layout(sensor)), pcap(path) {}
 
   config::SensorModel sensor;
+  detail::OusterPacketLayout layout;
   int rate_hz = 10;
   detail::PcapWriter pcap;
   uint16_t frame_id = 0;
@@ -163,23 +172,21 @@ void OusterPcapRecorder::add(const Scan& scan) {
   }
 
   // Lidar packets and IMU samples go out in time order.
-  const size_t pixels = static_cast<size_t>(s.beams);
-  const size_t column_bytes = kColumnHeaderBytes + pixels * kPixelBytes;
-  const size_t packet_bytes = kHeaderBytes + kColumnsPerPacket * column_bytes + kFooterBytes;
+  const detail::OusterPacketLayout& layout = st.layout;
   size_t next_imu = 0;
   const auto send_imu_until = [&](int64_t time_ns) {
     for (; next_imu < scan.imu.size() && scan.imu[next_imu].stamp_ns <= time_ns; ++next_imu) {
       const ImuSample& sample = scan.imu[next_imu];
       // A sample at the instant where one sweep ends and the next begins may come with both.
       if (st.imu_written && sample.stamp_ns <= st.last_imu_stamp_ns) continue;
-      uint8_t imu[kImuPacketBytes] = {};
+      uint8_t imu[kOusterImuPacketBytes] = {};
       for (size_t k = 0; k < 3; ++k)
         store_le_bytes(imu + 8 * k, static_cast<uint64_t>(sample.stamp_ns), 8);
       for (int k = 0; k < 3; ++k) {
         put_float(imu + 24 + 4 * k, sample.accel_mps2[k] / kStandardGravity);
         put_float(imu + 36 + 4 * k, sample.gyro_radps[k] * 180.0 / M_PI);
       }
-      st.pcap.add(sample.stamp_ns, kImuPort, kImuPort, imu, kImuPacketBytes);
+      st.pcap.add(sample.stamp_ns, kImuPort, kImuPort, imu, kOusterImuPacketBytes);
       ++st.imu_packets;
       st.imu_written = true;
       st.last_imu_stamp_ns = sample.stamp_ns;
@@ -187,7 +194,7 @@ void OusterPcapRecorder::add(const Scan& scan) {
   };
 
   for (int first = 0; first < s.columns; first += kColumnsPerPacket) {
-    st.packet.assign(packet_bytes, 0);
+    st.packet.assign(layout.packet_bytes, 0);
     uint8_t* p = st.packet.data();
     store_le_bytes(p, kLidarDataPacketType, 2);
     store_le_bytes(p + 2, st.frame_id, 2);
@@ -196,7 +203,7 @@ void OusterPcapRecorder::add(const Scan& scan) {
     int64_t sent_ns = 0;
     for (int k = 0; k < kColumnsPerPacket; ++k) {
       const int c = first + k;
-      uint8_t* column = p + kHeaderBytes + static_cast<size_t>(k) * column_bytes;
+      uint8_t* column = p + layout.header_bytes + static_cast<size_t>(k) * layout.column_bytes;
       if (c >= s.columns) {  // past the frame's last column: a column marked invalid
         store_le_bytes(column + 8, static_cast<uint64_t>(s.columns), 2);
         continue;
@@ -208,7 +215,8 @@ void OusterPcapRecorder::add(const Scan& scan) {
       store_le_bytes(column + 10, 1, 2);  // status: valid
       for (int row = 0; row < s.beams; ++row) {
         const size_t i = scan.index(row, c);
-        uint8_t* pixel = column + kColumnHeaderBytes + static_cast<size_t>(row) * kPixelBytes;
+        uint8_t* pixel =
+            column + layout.column_header_bytes + static_cast<size_t>(row) * layout.pixel_bytes;
         const double range_mm = std::round(static_cast<double>(scan.range_m[i]) * 1000.0);
         if (scan.valid[i] && range_mm > 0.0 && range_mm <= kMaxRangeMm) {
           store_le_bytes(pixel, static_cast<uint32_t>(range_mm), 4);
