@@ -19,6 +19,22 @@ std::optional<VelodyneModel> velodyne_model_from_product_id(uint8_t id) {
   }
 }
 
+std::optional<uint8_t> velodyne_product_id(VelodyneModel model) {
+  switch (model) {
+    case VelodyneModel::kHdl32e:
+      return 0x21;
+    case VelodyneModel::kVlp16:
+      return 0x22;
+    case VelodyneModel::kVlp32c:
+      return 0x28;
+    case VelodyneModel::kVls128:
+      return 0xA1;
+    case VelodyneModel::kHdl64e:
+      break;
+  }
+  return std::nullopt;
+}
+
 std::optional<VelodyneModel> velodyne_model_from_preset(const std::string& preset) {
   if (preset == "vlp16") return VelodyneModel::kVlp16;
   if (preset == "vlp32c") return VelodyneModel::kVlp32c;

@@ -27,6 +27,10 @@ inline constexpr size_t kVelodyneProductIdByte = 1205;
 /// no product id; nullopt for those and unknown values.
 std::optional<VelodyneModel> velodyne_model_from_product_id(uint8_t id);
 
+/// The product id a model's packets carry (the VLP-16's own, 0x22; nullopt for the
+/// HDL-64E, whose packets carry none): velodyne_model_from_product_id's inverse.
+std::optional<uint8_t> velodyne_product_id(VelodyneModel model);
+
 /// The model of a sensor preset name (vlp16, vlp32c, hdl32, hdl64, vls128), or nullopt.
 std::optional<VelodyneModel> velodyne_model_from_preset(const std::string& preset);
 

@@ -25,21 +25,6 @@ constexpr size_t kTimeStampByte = 1200;
 constexpr uint8_t kStrongestReturn = 0x37;
 constexpr int64_t kHourUs = int64_t{3600} * 1000000;
 
-uint8_t product_id(VelodyneModel model) {
-  switch (model) {
-    case VelodyneModel::kHdl32e:
-      return 0x21;
-    case VelodyneModel::kVlp16:
-      return 0x22;
-    case VelodyneModel::kVlp32c:
-      return 0x28;
-    case VelodyneModel::kHdl64e:  // no product id; not written
-    case VelodyneModel::kVls128:
-      break;
-  }
-  return 0;
-}
-
 }  // namespace
 
 struct VelodynePcapRecorder::State {
@@ -101,7 +86,8 @@ void VelodynePcapRecorder::State::fire(const Scan* scan, int c, int64_t column, 
   if (++firings < per_packet) return;
   // Sent once its last firing was measured.
   packet[kVelodyneReturnModeByte] = kStrongestReturn;
-  packet[kVelodyneProductIdByte] = product_id(geometry.model);
+  // The models written all have one (velodyne_firing_geometry refuses the HDL-64E).
+  packet[kVelodyneProductIdByte] = velodyne_product_id(geometry.model).value_or(0);
   pcap.add(time_ns, kDataPort, kDataPort, packet.data(), packet.size());
   ++packets;
   packet.fill(0);
