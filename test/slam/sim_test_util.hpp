@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/mesh/triangle_mesh.hpp"
+#include "featsense/slam/sim/lidar_simulator.hpp"
 
 namespace featsense::test {
 
@@ -42,6 +44,20 @@ inline mesh::TriangleMesh box_mesh(const Box& box) {
   mesh.add_box(box.lo.cast<float>(), box.hi.cast<float>(), part);
   return mesh;
 }
+
+/// A walk through the box room, (-2, -1, 1.4) to (2, 1, 1.6) m in one second, and what a
+/// simulator of it refers to: the simulator must not outlive the walk.
+struct BoxRoomWalk {
+  Box box;
+  mesh::TriangleMesh mesh = box_mesh(box);
+  slam::RayCaster caster{mesh};
+  std::unique_ptr<slam::PoseCurve> trajectory =
+      slam::make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+
+  slam::LidarSimulator simulator(const slam::SimulationSettings& settings) const {
+    return slam::LidarSimulator(mesh, caster, *trajectory, settings);
+  }
+};
 
 /// Distance of a point to the nearest face plane of the box (the point is inside).
 inline double distance_to_box(const Eigen::Vector3d& p, const Box& box) {

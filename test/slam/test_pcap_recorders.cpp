@@ -13,6 +13,7 @@
 #include "featsense/slam/io/ouster_metadata.hpp"
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
+#include "scan_read_back.hpp"
 #include "sim_test_util.hpp"
 
 namespace featsense::slam {
@@ -30,15 +31,11 @@ struct Recorded {
 /// `count` frames of a walk through the box room, recorded as packets and read back.
 Recorded record_and_read(const config::SensorModel& sensor, const std::string& name,
                          int count = 3) {
-  const test::Box box;
-  const mesh::TriangleMesh mesh = test::box_mesh(box);
-  const RayCaster caster(mesh);
-  const auto trajectory =
-      make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+  const test::BoxRoomWalk walk;
   SimulationSettings settings;
   settings.sensor = sensor;
   settings.measurement.seed = 3;
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
+  const LidarSimulator simulator = walk.simulator(settings);
 
   const fs::path dir = fs::temp_directory_path() / ("featsense_pcap_recorder_" + name);
   fs::remove_all(dir);
@@ -55,12 +52,10 @@ Recorded record_and_read(const config::SensorModel& sensor, const std::string& n
     recorder.finish();
     out.lidar_packets = recorder.lidar_packets();
   }
-  SourceOptions options;
-  options.min_range_m = 0.0;
-  const auto source = open_scan_source((dir / "recording.pcap").string(), options);
-  while (auto scan = source->next()) out.read_back.push_back(std::move(*scan));
-  EXPECT_EQ(source->stats().warning_count, 0u)
-      << (source->stats().warnings.empty() ? "" : source->stats().warnings.front());
+  test::ReadBack read = test::read_back(dir / "recording.pcap");
+  out.read_back = std::move(read.scans);
+  EXPECT_EQ(read.stats.warning_count, 0u)
+      << (read.stats.warnings.empty() ? "" : read.stats.warnings.front());
   fs::remove_all(dir);
   return out;
 }

@@ -14,6 +14,7 @@
 #include "featsense/slam/io/pcap_recorders.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "pcap_test_util.hpp"
+#include "scan_read_back.hpp"
 #include "sim_test_util.hpp"
 #include "velodyne/velodyne_firing.hpp"
 #include "velodyne/velodyne_firing_geometry.hpp"
@@ -32,15 +33,11 @@ struct Recorded {
 
 /// `count` revolutions of a walk through the box room, recorded as packets and read back.
 Recorded record_and_read(const std::string& preset, double rate_hz, int count = 3) {
-  const test::Box box;
-  const mesh::TriangleMesh mesh = test::box_mesh(box);
-  const RayCaster caster(mesh);
-  const auto trajectory =
-      make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+  const test::BoxRoomWalk walk;
   SimulationSettings settings;
   settings.sensor = velodyne_firing_sensor(preset, rate_hz);
   settings.measurement.seed = 3;
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
+  const LidarSimulator simulator = walk.simulator(settings);
 
   const fs::path dir = fs::temp_directory_path() / ("featsense_velodyne_recorder_" + preset);
   fs::remove_all(dir);
@@ -55,15 +52,13 @@ Recorded record_and_read(const std::string& preset, double rate_hz, int count = 
     recorder.finish();
     out.packets = recorder.packets();
   }
-  SourceOptions options;
-  options.min_range_m = 0.0;
-  const auto source = open_scan_source((dir / "recording.pcap").string(), options);
-  out.detail = source->info().detail;
+  test::ReadBack read = test::read_back(dir / "recording.pcap");
+  out.detail = read.info.detail;
   // The reader's rows are the simulated rows.
-  EXPECT_EQ(source->info().sensor.elevation_rad, settings.sensor.elevation_rad);
-  while (auto scan = source->next()) out.read_back.push_back(std::move(*scan));
-  EXPECT_EQ(source->stats().warning_count, 0u)
-      << (source->stats().warnings.empty() ? "" : source->stats().warnings.front());
+  EXPECT_EQ(read.info.sensor.elevation_rad, settings.sensor.elevation_rad);
+  out.read_back = std::move(read.scans);
+  EXPECT_EQ(read.stats.warning_count, 0u)
+      << (read.stats.warnings.empty() ? "" : read.stats.warnings.front());
   fs::remove_all(dir);
   return out;
 }
@@ -229,14 +224,10 @@ TEST(VelodynePcapRecorder, Vlp16ScansOfTwoSequencesPerBlockReadBackAsSimulated) 
 }
 
 TEST(VelodynePcapRecorder, ScanAfterAGapStartsAPacketOfItsOwn) {
-  const test::Box box;
-  const mesh::TriangleMesh mesh = test::box_mesh(box);
-  const RayCaster caster(mesh);
-  const auto trajectory =
-      make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+  const test::BoxRoomWalk walk;
   SimulationSettings settings;
   settings.sensor = velodyne_firing_sensor("vlp32c");
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
+  const LidarSimulator simulator = walk.simulator(settings);
   const fs::path path = fs::temp_directory_path() / "featsense_velodyne_gap.pcap";
   std::vector<Scan> made;
   VelodynePcapRecorder recorder(path.string(), "vlp32c");
@@ -289,25 +280,11 @@ TEST(VelodynePcapRecorder, WhatIsNoWritableVelodyneIsRefused) {
   fs::remove(path);
 }
 
-/// The scans of a pcap and its reader's warnings.
-std::pair<std::vector<Scan>, ReadStats> read_pcap(const fs::path& path) {
-  SourceOptions options;
-  options.min_range_m = 0.0;
-  const auto source = open_scan_source(path.string(), options);
-  std::vector<Scan> scans;
-  while (auto scan = source->next()) scans.push_back(std::move(*scan));
-  return {std::move(scans), source->stats()};
-}
-
 TEST(VelodynePcapRecorder, OtherDatagramsOnTheDataPortAreCountedPositionPacketsNot) {
-  const test::Box box;
-  const mesh::TriangleMesh mesh = test::box_mesh(box);
-  const RayCaster caster(mesh);
-  const auto trajectory =
-      make_spline_trajectory({Eigen::Vector3d(-2, -1, 1.4), Eigen::Vector3d(2, 1, 1.6)}, 1.0);
+  const test::BoxRoomWalk walk;
   SimulationSettings settings;
   settings.sensor = velodyne_firing_sensor("hdl32", 10.0);
-  const LidarSimulator simulator(mesh, caster, *trajectory, settings);
+  const LidarSimulator simulator = walk.simulator(settings);
   const fs::path dir = fs::temp_directory_path() / "featsense_velodyne_foreign_datagrams";
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -332,9 +309,13 @@ TEST(VelodynePcapRecorder, OtherDatagramsOnTheDataPortAreCountedPositionPacketsN
   extra(90, 300, 5000);
   test::write_file(dir / "mixed.pcap", test::write_pcap(frames));
 
-  const auto [clean, clean_stats] = read_pcap(dir / "clean.pcap");
-  const auto [mixed, mixed_stats] = read_pcap(dir / "mixed.pcap");
+  const test::ReadBack clean_read = test::read_back(dir / "clean.pcap");
+  const test::ReadBack mixed_read = test::read_back(dir / "mixed.pcap");
   fs::remove_all(dir);
+  const std::vector<Scan>& clean = clean_read.scans;
+  const std::vector<Scan>& mixed = mixed_read.scans;
+  const ReadStats& clean_stats = clean_read.stats;
+  const ReadStats& mixed_stats = mixed_read.stats;
   ASSERT_EQ(clean_stats.warning_count, 0u);
   ASSERT_EQ(mixed.size(), clean.size());
   for (size_t i = 0; i < clean.size(); ++i) EXPECT_EQ(mixed[i].valid, clean[i].valid) << i;
