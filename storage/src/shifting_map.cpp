@@ -82,6 +82,29 @@ void copy_brick_from_chunk(const Chunk& chunk, Index3 corner, uint32_t* brick_vo
   }
 }
 
+/// Copies the voxels of `brick` (brick order) that lie in the block of `dim` voxels from global
+/// voxel `origin` into the block's x-fastest array.
+void copy_brick_into_block(const uint32_t* brick_voxels, Index3 brick, Index3 origin, Index3 dim,
+                           std::vector<uint32_t>& block) {
+  const Index3 first = tsdf::LocalMapGeometry::first_voxel_of_brick(brick);
+  for (int32_t z = 0; z < kBrickSize; ++z) {
+    const int32_t bz = first.z + z - origin.z;
+    if (bz < 0 || bz >= dim.z) continue;
+    for (int32_t y = 0; y < kBrickSize; ++y) {
+      const int32_t by = first.y + y - origin.y;
+      if (by < 0 || by >= dim.y) continue;
+      for (int32_t x = 0; x < kBrickSize; ++x) {
+        const int32_t bx = first.x + x - origin.x;
+        if (bx < 0 || bx >= dim.x) continue;
+        block[static_cast<size_t>(bx) +
+              static_cast<size_t>(dim.x) *
+                  (static_cast<size_t>(by) + static_cast<size_t>(dim.y) * static_cast<size_t>(bz))] =
+            brick_voxels[(z * kBrickSize + y) * kBrickSize + x];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 uint64_t chunk_digest(const Chunk& chunk) {
@@ -166,6 +189,34 @@ void ShiftingMap::sync() {
   spill(bricks, [&](size_t k) { return all.data() + geometry.brick_offset(bricks[k]); });
   store_.flush();
   ++stats_.syncs;
+}
+
+void ShiftingMap::read_block(Index3 origin, Index3 dim, std::vector<uint32_t>& voxels) {
+  if (dim.x <= 0 || dim.y <= 0 || dim.z <= 0) throw std::invalid_argument("read_block: empty box");
+  voxels.assign(static_cast<size_t>(dim.x) * static_cast<size_t>(dim.y) * static_cast<size_t>(dim.z),
+                tsdf::kUnobservedVoxel);
+  // Bricks lie wholly inside the local map or wholly outside it (both are whole bricks).
+  const tsdf::LocalMapGeometry& geometry = map_.geometry();
+  std::vector<Index3> inside;
+  std::vector<Index3> outside;
+  for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z) {
+    for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y) {
+      for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x) {
+        (geometry.contains_brick({x, y, z}) ? inside : outside).push_back({x, y, z});
+      }
+    }
+  }
+  std::vector<uint32_t> bricks;
+  if (!inside.empty()) {
+    map_.read_bricks(inside, bricks);
+    for (size_t k = 0; k < inside.size(); ++k)
+      copy_brick_into_block(bricks.data() + k * kBrickVoxels, inside[k], origin, dim, voxels);
+  }
+  if (!outside.empty()) {
+    load(outside, bricks);
+    for (size_t k = 0; k < outside.size(); ++k)
+      copy_brick_into_block(bricks.data() + k * kBrickVoxels, outside[k], origin, dim, voxels);
+  }
 }
 
 template <typename VoxelsOf>

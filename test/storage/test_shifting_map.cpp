@@ -229,6 +229,48 @@ TEST_P(ShiftingMapTest, ContinuingFromAStoreGivesTheMapOfOneRun) {
   expect_same_map(store, *map_without_shifting(GetParam(), path));
 }
 
+TEST_P(ShiftingMapTest, ABlockReadWhileMappingIsTheWholeMapsVoxels) {
+  // Half-way along the path (never synced) the map lies partly in the local map, partly in the
+  // store; a block read across both is the map of one large map at the same scans.
+  std::vector<Vec3> path = sensor_path();
+  path.resize(path.size() / 2);
+  MemoryChunkStore store(metadata());
+  auto map = make_map(GetParam(), small_map_settings(), path.front());
+  ShiftingMap shifting(*map, store, kShiftThreshold);
+  for (const Vec3& p : path) {
+    shifting.follow(p);
+    const double origin[3] = {p.x, p.y, p.z};
+    map->integrate(scan_from(origin));
+  }
+  ASSERT_GE(shifting.stats().shifts, 4u);
+  ASSERT_FALSE(store.keys().empty());
+  const auto reference = map_without_shifting(GetParam(), path);
+  const tsdf::LocalMapGeometry& g = reference->geometry();
+  const std::vector<uint32_t> expected_all = reference->download();
+  // An odd box, not aligned to bricks or chunks, reaching past the reference map on one side.
+  const Index3 origin{g.origin.x + 3, g.origin.y - 5, g.origin.z + 7};
+  const Index3 dim{g.dim.x - 1, g.dim.y - 11, g.dim.z - 9};
+  std::vector<uint32_t> block;
+  shifting.read_block(origin, dim, block);
+  ASSERT_EQ(block.size(), static_cast<size_t>(dim.x) * dim.y * dim.z);
+  size_t differing = 0;
+  size_t observed = 0;
+  for (int32_t z = 0; z < dim.z; ++z) {
+    for (int32_t y = 0; y < dim.y; ++y) {
+      for (int32_t x = 0; x < dim.x; ++x) {
+        const Index3 v{origin.x + x, origin.y + y, origin.z + z};
+        const uint32_t expected =
+            g.contains(v) ? expected_all[g.linear(v)] : tsdf::kUnobservedVoxel;
+        const uint32_t actual = block[x + dim.x * (y + static_cast<size_t>(dim.y) * z)];
+        differing += expected != actual;
+        observed += tsdf::unpack(actual).weight > 0;
+      }
+    }
+  }
+  EXPECT_GT(observed, 50000u);
+  EXPECT_EQ(differing, 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, ShiftingMapTest, ::testing::Values("cpu", "cuda"));
 
 TEST(ShiftingMap, MovingFarAwayAndBackLosesNothing) {

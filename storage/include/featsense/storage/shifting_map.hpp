@@ -42,6 +42,11 @@ class ShiftingMap {
   /// Writes the local map's observed chunks into the store (unchanged ones are skipped) and
   /// flushes the store: afterwards the store alone holds the whole map, durably.
   void sync();
+  /// The whole map's voxels in the box of `dim` voxels from global voxel `origin`, x fastest
+  /// (index x + dim.x * (y + dim.y * z)): from the local map where it covers them, else from
+  /// the store (unobserved where neither holds them). For a preview of the map while it is
+  /// made; the store is only read.
+  void read_block(tsdf::Index3 origin, tsdf::Index3 dim, std::vector<uint32_t>& voxels);
 
   /// The centre of the local map, map frame, metres.
   tsdf::Vec3 centre_m() const;
