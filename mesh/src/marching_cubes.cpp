@@ -69,6 +69,12 @@ void check_settings(const MeshingSettings& settings, const storage::MapMetadata&
   }
 }
 
+/// At least 1: an unobserved voxel (weight 0) never takes part, whatever the setting.
+uint32_t min_weight_fixed(double min_weight) {
+  return std::max<uint32_t>(
+      1u, static_cast<uint32_t>(std::min(65535.0, std::round(min_weight * tsdf::kWeightScale))));
+}
+
 struct WorkItem {
   internal::ChunkNeighbourhood neighbourhood;
   internal::ChunkMeshingParameters parameters;
@@ -93,10 +99,7 @@ TriangleMesh extract_mesh(storage::ChunkStore& store, const MeshingSettings& set
 
   internal::ChunkMeshingParameters base;
   base.voxel_size_m = metadata.voxel_size_m;
-  // At least 1: an unobserved voxel (weight 0) never takes part, whatever the setting.
-  base.min_weight_fixed =
-      std::max<uint32_t>(1u, static_cast<uint32_t>(std::min(
-                                 65535.0, std::round(settings.min_weight * tsdf::kWeightScale))));
+  base.min_weight_fixed = min_weight_fixed(settings.min_weight);
   const CubeBounds bounds = cube_bounds(settings, metadata.voxel_size_m);
 
   const std::vector<ChunkKey> stored = store.keys();
@@ -159,6 +162,35 @@ TriangleMesh extract_mesh(const std::vector<uint32_t>& voxels, tsdf::Index3 orig
   metadata.truncation_m = truncation_m;
   internal::DenseBlockStore store(voxels, origin, dim, metadata);
   return extract_mesh(store, settings, stats);
+}
+
+static_assert(kPaddedChunkSize == internal::kPaddedSize);
+
+TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t> padded,
+                                double voxel_size_m, double min_weight) {
+  if (padded.size() != internal::kPaddedVoxels) {
+    throw std::invalid_argument("a chunk's padded block holds " +
+                                std::to_string(internal::kPaddedVoxels) + " voxels, got " +
+                                std::to_string(padded.size()));
+  }
+  MeshingSettings settings;
+  settings.min_weight = min_weight;
+  storage::MapMetadata metadata;
+  metadata.voxel_size_m = voxel_size_m;
+  metadata.truncation_m = 1.0;  // not used by the cubes; checked only to be positive
+  check_settings(settings, metadata);
+  internal::ChunkMeshingParameters parameters;
+  parameters.voxel_size_m = voxel_size_m;
+  parameters.min_weight_fixed = min_weight_fixed(min_weight);
+  internal::PaddedBlock block;
+  block.key = key;
+  block.voxels = std::move(padded);
+  internal::ChunkMesh part = internal::mesh_chunk(block, parameters);
+  TriangleMesh mesh;
+  mesh.vertices = std::move(part.vertices);
+  mesh.normals = std::move(part.normals);
+  mesh.triangles = std::move(part.triangles);
+  return mesh;
 }
 
 }  // namespace featsense::mesh

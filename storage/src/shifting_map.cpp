@@ -97,8 +97,8 @@ void copy_brick_into_block(const uint32_t* brick_voxels, Index3 brick, Index3 or
         const int32_t bx = first.x + x - origin.x;
         if (bx < 0 || bx >= dim.x) continue;
         block[static_cast<size_t>(bx) +
-              static_cast<size_t>(dim.x) *
-                  (static_cast<size_t>(by) + static_cast<size_t>(dim.y) * static_cast<size_t>(bz))] =
+              static_cast<size_t>(dim.x) * (static_cast<size_t>(by) +
+                                            static_cast<size_t>(dim.y) * static_cast<size_t>(bz))] =
             brick_voxels[(z * kBrickSize + y) * kBrickSize + x];
       }
     }
@@ -193,8 +193,9 @@ void ShiftingMap::sync() {
 
 void ShiftingMap::read_block(Index3 origin, Index3 dim, std::vector<uint32_t>& voxels) {
   if (dim.x <= 0 || dim.y <= 0 || dim.z <= 0) throw std::invalid_argument("read_block: empty box");
-  voxels.assign(static_cast<size_t>(dim.x) * static_cast<size_t>(dim.y) * static_cast<size_t>(dim.z),
-                tsdf::kUnobservedVoxel);
+  voxels.assign(
+      static_cast<size_t>(dim.x) * static_cast<size_t>(dim.y) * static_cast<size_t>(dim.z),
+      tsdf::kUnobservedVoxel);
   // Bricks lie wholly inside the local map or wholly outside it (both are whole bricks).
   const tsdf::LocalMapGeometry& geometry = map_.geometry();
   std::vector<Index3> inside;

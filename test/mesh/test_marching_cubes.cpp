@@ -248,6 +248,60 @@ TEST(MarchingCubes, DenseBlockGivesTheSameMeshAsTheStore) {
                std::invalid_argument);
 }
 
+/// Each triangle as its three corners' positions, starting at the smallest (the winding kept),
+/// sorted: the same surface whatever the vertex numbering.
+std::vector<std::array<float, 9>> triangle_corners(const mesh::TriangleMesh& m) {
+  std::vector<std::array<float, 9>> corners;
+  for (const Eigen::Vector3i& t : m.triangles) {
+    std::array<std::array<float, 3>, 3> c;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f& v = m.vertices[static_cast<size_t>(t[k])];
+      c[static_cast<size_t>(k)] = {v.x(), v.y(), v.z()};
+    }
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+    corners.push_back(
+        {c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2]});
+  }
+  std::sort(corners.begin(), corners.end());
+  return corners;
+}
+
+TEST(MarchingCubes, ChunkByChunkGivesTheStoresMesh) {
+  storage::MemoryChunkStore store = sphere_store();
+  std::map<storage::ChunkKey, storage::Chunk> chunks;
+  for (const storage::ChunkKey& key : store.keys()) chunks[key] = *store.read(key);
+  const auto voxel = [&](int32_t gx, int32_t gy, int32_t gz) -> uint32_t {
+    const storage::ChunkKey key = storage::chunk_of_voxel(gx, gy, gz);
+    const auto found = chunks.find(key);
+    if (found == chunks.end()) return 0u;
+    return found->second.at(gx - key.x * storage::kChunkSize, gy - key.y * storage::kChunkSize,
+                            gz - key.z * storage::kChunkSize);
+  };
+  mesh::TriangleMesh united;
+  for (const storage::ChunkKey& key : store.keys()) {
+    constexpr int32_t n = mesh::kPaddedChunkSize;
+    std::vector<uint32_t> padded(static_cast<size_t>(n * n * n));
+    for (int32_t z = 0; z < n; ++z)
+      for (int32_t y = 0; y < n; ++y)
+        for (int32_t x = 0; x < n; ++x) {
+          padded[static_cast<size_t>(x + n * (y + n * z))] =
+              voxel(key.x * storage::kChunkSize - 1 + x, key.y * storage::kChunkSize - 1 + y,
+                    key.z * storage::kChunkSize - 1 + z);
+        }
+    const mesh::TriangleMesh part = mesh::extract_chunk_mesh(key, std::move(padded), kVoxel, 0.5);
+    ASSERT_EQ(part.normals.size(), part.vertices.size());
+    const int first = static_cast<int>(united.vertices.size());
+    united.vertices.insert(united.vertices.end(), part.vertices.begin(), part.vertices.end());
+    for (const Eigen::Vector3i& t : part.triangles)
+      united.triangles.push_back(t + Eigen::Vector3i::Constant(first));
+  }
+  const mesh::TriangleMesh whole = mesh::extract_mesh(store, {});
+  ASSERT_GT(whole.triangles.size(), 1000u);
+  EXPECT_EQ(triangle_corners(united), triangle_corners(whole));
+  EXPECT_THROW(mesh::extract_chunk_mesh({0, 0, 0}, std::vector<uint32_t>(64), kVoxel, 0.5),
+               std::invalid_argument);
+}
+
 TEST(MarchingCubes, EmptyStoreAndBadSettings) {
   storage::MemoryChunkStore store(test_metadata(kVoxel, kTau));
   EXPECT_TRUE(mesh::extract_mesh(store, {}).vertices.empty());

@@ -55,4 +55,17 @@ TriangleMesh extract_mesh(const std::vector<uint32_t>& voxels, tsdf::Index3 orig
                           tsdf::Index3 dim, double voxel_size_m, double truncation_m,
                           const MeshingSettings& settings, MeshingStats* stats = nullptr);
 
+/// Voxels along each edge of a chunk's padded block (extract_chunk_mesh): one before the chunk
+/// and two after it.
+inline constexpr int32_t kPaddedChunkSize = storage::kChunkSize + 3;
+
+/// Meshes one chunk from its padded block: the voxels of global indices key * 64 - 1 to
+/// key * 64 + 65 per axis, x fastest (kPaddedChunkSize^3 of them). The result holds the
+/// cubes whose lowest voxel lies in the chunk, with normals: the chunk's part of extract_mesh
+/// over a store of the same voxels, not welded to its neighbours' parts. For previews of a map
+/// being made, a chunk at a time. Throws std::invalid_argument for a block of another size or
+/// bad settings.
+TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t> padded,
+                                double voxel_size_m, double min_weight);
+
 }  // namespace featsense::mesh
