@@ -50,6 +50,7 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
                        {"integrate", timing_json(run.timings.integrate_ms)},
                        {"flush", timing_json(run.timings.flush_ms)},
                        {"final_flush", timing_json(run.timings.final_flush_ms)},
+                       {"preview", timing_json(run.timings.preview_ms)},
                        {"latency",
                         {{"pose", timing_json(run.timings.latency_pose_ms)},
                          {"final_pose", timing_json(run.timings.latency_final_pose_ms)},

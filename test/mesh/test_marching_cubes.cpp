@@ -10,6 +10,7 @@
 #include <set>
 #include <utility>
 
+#include "common/triangle_corners.hpp"
 #include "featsense/mesh/marching_cubes.hpp"
 #include "mesh/tsdf_test_fields.hpp"
 
@@ -248,24 +249,6 @@ TEST(MarchingCubes, DenseBlockGivesTheSameMeshAsTheStore) {
                std::invalid_argument);
 }
 
-/// Each triangle as its three corners' positions, starting at the smallest (the winding kept),
-/// sorted: the same surface whatever the vertex numbering.
-std::vector<std::array<float, 9>> triangle_corners(const mesh::TriangleMesh& m) {
-  std::vector<std::array<float, 9>> corners;
-  for (const Eigen::Vector3i& t : m.triangles) {
-    std::array<std::array<float, 3>, 3> c;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3f& v = m.vertices[static_cast<size_t>(t[k])];
-      c[static_cast<size_t>(k)] = {v.x(), v.y(), v.z()};
-    }
-    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
-    corners.push_back(
-        {c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2]});
-  }
-  std::sort(corners.begin(), corners.end());
-  return corners;
-}
-
 TEST(MarchingCubes, ChunkByChunkGivesTheStoresMesh) {
   storage::MemoryChunkStore store = sphere_store();
   std::map<storage::ChunkKey, storage::Chunk> chunks;
@@ -290,10 +273,7 @@ TEST(MarchingCubes, ChunkByChunkGivesTheStoresMesh) {
         }
     const mesh::TriangleMesh part = mesh::extract_chunk_mesh(key, std::move(padded), kVoxel, 0.5);
     ASSERT_EQ(part.normals.size(), part.vertices.size());
-    const int first = static_cast<int>(united.vertices.size());
-    united.vertices.insert(united.vertices.end(), part.vertices.begin(), part.vertices.end());
-    for (const Eigen::Vector3i& t : part.triangles)
-      united.triangles.push_back(t + Eigen::Vector3i::Constant(first));
+    united = append_mesh(std::move(united), part);
   }
   const mesh::TriangleMesh whole = mesh::extract_mesh(store, {});
   ASSERT_GT(whole.triangles.size(), 1000u);

@@ -1,5 +1,7 @@
 #include "featsense/mapping/map_pass.hpp"
 
+#include "preview_mesher.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 #include <utility>
@@ -67,6 +69,10 @@ MapPass::MapPass(slam::ScanLocator& locator, const PassSettings& settings,
   if (settings_.loops)
     loops_ =
         std::make_unique<LoopStage>(*settings_.loops, settings_.relocalize, settings_.real_time);
+  if (settings_.preview) {
+    preview_ = std::make_unique<PreviewMesher>(*settings_.preview, config_.map.voxel_size_m,
+                                               config_.map.truncation_m);
+  }
 }
 
 MapPass::~MapPass() {
@@ -100,8 +106,12 @@ std::optional<PlacedScan> MapPass::locate(slam::Scan scan, std::string* why_out)
   if (!why.empty()) warn(why);
   if (why_out) *why_out = why;
   result_.timings.locate_ms.push_back(ms_since(start));
-  if (const std::optional<double> ms = latency_.since_ready(scan.sequence)) {
-    result_.timings.latency_pose_ms.push_back(*ms);
+  const std::optional<double> latency_ms = latency_.since_ready(scan.sequence);
+  if (latency_ms) result_.timings.latency_pose_ms.push_back(*latency_ms);
+  if (preview_) {
+    std::lock_guard<std::mutex> lock(latest_mutex_);
+    latest_ = {placement->T_map_sensor, placement->stamp_ns, true,
+               latency_ms ? *latency_ms : std::nan("")};
   }
   return PlacedScan{std::move(scan), std::move(*placement)};
 }
@@ -177,15 +187,18 @@ void MapPass::open_map(const LocatedScan& first) {
 }
 
 void MapPass::integrate(LocatedScan scan) {
+  if (preview_) preview_->add_pose(scan.placement.stamp_ns, scan.placement.T_map_sensor);
   if (settings_.integrate && !scan.integrate) {  // skipped to keep up: the pose only
     result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
     ++result_.real_time.integrations_skipped;
+    update_preview(false);
     return;
   }
   if (!settings_.integrate) {
     result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
     ++result_.frames_mapped;
     report_progress();
+    update_preview(false);
     return;
   }
   if (!store_->map) open_map(scan);
@@ -201,6 +214,7 @@ void MapPass::integrate(LocatedScan scan) {
   result_.voxels_updated += stats.voxels_updated;
   if (const std::optional<double> ms = latency_.since_ready(scan.placement.sequence, true)) {
     result_.timings.latency_integrated_ms.push_back(*ms);
+    integration_latency_ms_ = *ms;
   }
   result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
   ++result_.frames_mapped;
@@ -212,7 +226,35 @@ void MapPass::integrate(LocatedScan scan) {
     result_.timings.flush_ms.push_back(ms_since(start));
     last_flush_ = Clock::now();
   }
+  if (preview_) preview_->mark(scan.rays);
   report_progress();
+  update_preview(false);
+}
+
+void MapPass::update_preview(bool last) {
+  if (!preview_ || (!last && !preview_->due())) return;
+  const Clock::time_point start = Clock::now();
+  MapPreview status;
+  {
+    std::lock_guard<std::mutex> lock(latest_mutex_);
+    status.latest_pose = latest_.pose;
+    status.latest_stamp_ns = latest_.stamp_ns;
+    status.has_latest_pose = latest_.known;
+    status.pose_latency_ms = latest_.latency_ms;
+  }
+  status.integration_latency_ms = integration_latency_ms_;
+  status.frames_read = frames_read_.load();
+  status.frames_mapped = result_.frames_mapped;
+  status.integrations_skipped = result_.real_time.integrations_skipped;
+  storage::ShiftingMap* map = store_ ? store_->map.get() : nullptr;
+  Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
+  if (!result_.poses.empty()) sensor = result_.poses.poses.back().translation();
+  if (last) {
+    preview_->finish(map, sensor, std::move(status));
+  } else {
+    preview_->refresh(map, sensor, std::move(status));
+  }
+  result_.timings.preview_ms.push_back(ms_since(start));
 }
 
 void MapPass::report_progress() {
@@ -241,6 +283,7 @@ void MapPass::add_source_warnings(const slam::ReadStats& read) {
 
 void MapPass::abandon() {
   closed_ = true;
+  preview_.reset();
   if (loops_) loops_->abandon();
   if (!store_ || store_->closed) return;
   store_->closed = true;
@@ -300,6 +343,9 @@ PassResult MapPass::close() {
           static_cast<double>(result_.poses.stamps_ns.back() - result_.poses.stamps_ns.front()) *
           1e-9;
     }
+    // The last refresh before the store closes (it reads the chunks the local map left).
+    update_preview(true);
+    preview_.reset();
     if (store_) write_store();
   } catch (...) {
     abandon();

@@ -71,8 +71,11 @@ Mapper::Mapper(MapperSettings settings, RunEvents events)
                                        MapStoreRequest{}, events_);
     return;
   }
+  // The preview watches the first pass: a live run has no other.
+  PassSettings first = pass_settings_;
+  first.preview = settings_.preview;
   first_ = std::make_unique<MapPass>(
-      *locator_, pass_settings_, config, settings_.sensor,
+      *locator_, first, config, settings_.sensor,
       MapStoreRequest{settings_.map_path, settings_.sensor.name, settings_.continue_from,
                       settings_.overwrite, settings_.session, nullptr},
       events_);

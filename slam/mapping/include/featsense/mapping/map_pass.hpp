@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <filesystem>
 #include <memory>
@@ -18,6 +19,7 @@
 
 #include "featsense/config/config.hpp"
 #include "featsense/mapping/loop_stage.hpp"
+#include "featsense/mapping/map_preview.hpp"
 #include "featsense/mapping/map_sessions.hpp"
 #include "featsense/mapping/pass_result.hpp"
 #include "featsense/mapping/run_events.hpp"
@@ -60,6 +62,9 @@ struct PassSettings {
   /// A live source: the pipeline's real-time policy (map_pipeline.hpp) keeps the odometry at
   /// the sensor's pace; the loop closure skips keyframes rather than wait.
   bool real_time = false;
+  /// The map as it is made, re-meshed where it changed about every interval (map_preview.hpp);
+  /// none: no preview.
+  std::optional<MapPreviewSettings> preview;
 };
 
 /// map.flush_interval and sensor.drop_mixed_pixels of `config`: a pass that integrates, with
@@ -82,6 +87,8 @@ struct LocatedScan {
 
 /// Why the real-time policy dropped a whole scan before the odometry.
 enum class ScanDrop { kOdometryBehind, kRefinementBehind };
+
+class PreviewMesher;
 
 class MapPass {
  public:
@@ -145,6 +152,7 @@ class MapPass {
   void warn(const std::string& message);
   void open_map(const LocatedScan& first);
   void report_progress();
+  void update_preview(bool last);
   std::vector<PlacedScan> release(std::vector<slam::ScanPlacement> final);
   void write_store();
 
@@ -167,6 +175,17 @@ class MapPass {
   struct Store;
   std::unique_ptr<Store> store_;
   std::optional<size_t> total_frames_;
+  std::unique_ptr<PreviewMesher> preview_;
+  /// The front end's latest pose, for the preview (written by locate(), read by integrate()).
+  struct LatestPose {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    int64_t stamp_ns = 0;
+    bool known = false;
+    double latency_ms = std::nan("");
+  };
+  std::mutex latest_mutex_;
+  LatestPose latest_;
+  double integration_latency_ms_ = std::nan("");
   std::chrono::steady_clock::time_point started_;
   std::chrono::steady_clock::time_point last_flush_;
   bool closed_ = false;

@@ -24,6 +24,7 @@
 #include "featsense/mapping/map_pass.hpp"
 #include "featsense/mapping/map_pipeline.hpp"
 #include "featsense/mapping/map_policy.hpp"
+#include "featsense/mapping/map_preview.hpp"
 #include "featsense/mapping/pass_result.hpp"
 #include "featsense/mapping/recording.hpp"
 #include "featsense/mapping/relocalization_report.hpp"
@@ -60,6 +61,9 @@ struct MapperSettings {
   /// A live sensor: map_source() keeps the odometry at its pace by the real-time policy of
   /// map_pipeline.hpp (integrations skipped, then scans dropped, each counted).
   bool real_time = false;
+  /// The map as it is made, for a person watching (map_preview.hpp): the first pass re-meshes
+  /// the chunks that changed about every interval and hands them over. None: no preview.
+  std::optional<MapPreviewSettings> preview;
   /// The run as the map's new session: its input, format and how its poses were placed.
   SessionDescription session;
   /// Reads the input again from its start, for the second pass (and, continuing, for the

@@ -25,6 +25,9 @@ struct StageTimings {
   std::vector<double> integrate_ms;
   std::vector<double> flush_ms;
   std::vector<double> final_flush_ms;
+  /// The live preview's refreshes (map_preview.hpp) on the integrating thread: the changed
+  /// chunks copied out (their meshing runs on a thread of its own).
+  std::vector<double> preview_ms;
   double loops_finish_ms = 0.0;  ///< after the last scan: the keyframes left, the last solve
   /// Per scan, from when its source handed it out (a live sensor: about its last packet) to
   /// its pose from the front end, its final pose (after the refinement: the loop closure and
