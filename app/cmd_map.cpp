@@ -154,6 +154,7 @@ mapping::MapperSettings mapper_settings(const slam::SourceInfo& info,
                                         const SourceReopener& reopen) {
   mapping::MapperSettings settings;
   settings.real_time = options.real_time;
+  settings.preview = options.preview;
   settings.config = std::move(config);
   settings.sensor = info.sensor;
   settings.map_path = fs::path(options.output) / "map.h5";

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli_context.hpp"
+#include "featsense/mapping/map_preview.hpp"
 #include "featsense/mapping/recording.hpp"
 #include "featsense/slam/scan_source.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
@@ -39,6 +40,8 @@ struct MapOptions {
   bool poses_only = false;       ///< the poses and the report, no map
   bool print_summary = true;     ///< the one-line summary on stdout
   bool real_time = false;        ///< a live sensor: the pipeline's real-time policy
+  /// The map as it is made (`live --view`): the first pass's refreshes go to its deliver.
+  std::optional<mapping::MapPreviewSettings> preview;
 };
 
 struct MapOutcome {

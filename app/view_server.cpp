@@ -4,6 +4,7 @@
 #include <sys/socket.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <map>
 #include <thread>
 #include <utility>
@@ -56,6 +57,7 @@ void reuse_address_only(socket_t sock) {
 
 struct ViewServer::Impl {
   ViewContent content;
+  std::shared_ptr<const LiveView> live;
   std::map<std::string, StaticFile> three;
   httplib::Server server;
   std::atomic<bool> started{false};
@@ -63,27 +65,31 @@ struct ViewServer::Impl {
   std::atomic<bool> finished{false};
 };
 
-ViewServer::ViewServer(ViewContent content, const fs::path& three_folder)
-    : impl_(std::make_unique<Impl>()) {
+void ViewServer::serve_page(const fs::path& three_folder, const std::string& home) {
   impl_->three = read_three_js(three_folder);
-  impl_->content = std::move(content);
-  Impl& state = *impl_;
-  httplib::Server& server = state.server;
+  httplib::Server& server = impl_->server;
   server.set_socket_options(reuse_address_only);
-
   for (const viewer_export::PageFile& file : viewer_export::viewer_page_files()) {
     const auto serve = [&file](const httplib::Request&, httplib::Response& response) {
       response.set_content(file.body, file.content_type.c_str());
     };
     server.Get(file.path, serve);
-    if (file.path == "/index.html") server.Get("/", serve);
+    if (file.path == home) server.Get("/", serve);
   }
-  for (const auto& [route, file] : state.three) {
+  for (const auto& [route, file] : impl_->three) {
     const StaticFile* served = &file;
     server.Get("/three/" + route, [served](const httplib::Request&, httplib::Response& response) {
       response.set_content(served->body, served->content_type.c_str());
     });
   }
+}
+
+ViewServer::ViewServer(ViewContent content, const fs::path& three_folder)
+    : impl_(std::make_unique<Impl>()) {
+  serve_page(three_folder, "/index.html");
+  impl_->content = std::move(content);
+  Impl& state = *impl_;
+  httplib::Server& server = state.server;
   server.Get("/scene.json", [&state](const httplib::Request&, httplib::Response& response) {
     response.set_header("Cache-Control", "no-store");
     response.set_content(state.content.scene.dump(), kJson);
@@ -102,6 +108,38 @@ ViewServer::ViewServer(ViewContent content, const fs::path& three_folder)
     }
     response.set_content(state.content.plan_png, "image/png");
   });
+}
+
+namespace {
+
+/// A query parameter as a count; 0 where it is missing or not a number.
+uint64_t count_parameter(const httplib::Request& request, const char* name) {
+  if (!request.has_param(name)) return 0;
+  const std::string text = request.get_param_value(name);
+  char* end = nullptr;
+  const unsigned long long value = std::strtoull(text.c_str(), &end, 10);
+  return end != text.c_str() && *end == '\0' ? value : 0;
+}
+
+}  // namespace
+
+ViewServer::ViewServer(std::shared_ptr<const LiveView> live, const fs::path& three_folder)
+    : impl_(std::make_unique<Impl>()) {
+  serve_page(three_folder, "/live.html");
+  impl_->live = std::move(live);
+  const LiveView* view = impl_->live.get();
+  httplib::Server& server = impl_->server;
+  server.Get(
+      "/live/status.json", [view](const httplib::Request& request, httplib::Response& response) {
+        response.set_header("Cache-Control", "no-store");
+        response.set_content(view->status(count_parameter(request, "path_from")).dump(), kJson);
+      });
+  server.Get("/live/mesh.bin",
+             [view](const httplib::Request& request, httplib::Response& response) {
+               response.set_header("Cache-Control", "no-store");
+               response.set_content(view->changes_since(count_parameter(request, "since")),
+                                    "application/octet-stream");
+             });
 }
 
 ViewServer::~ViewServer() = default;

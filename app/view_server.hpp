@@ -8,12 +8,16 @@
 //   /scene.json   counts, bounds, layers, paths (view_content.hpp)
 //   /mesh.bin     the mesh (viewer_export/viewer_mesh_binary.hpp)
 //   /plan.png     topdown.png, 404 where there is none
+// or, serving a live run (live_view.hpp), the live page at / and
+//   /live/status.json?path_from=N   the run's figures, the latest pose, the path from N on
+//   /live/mesh.bin?since=V          the chunks changed after version V
 
 #include <atomic>
 #include <filesystem>
 #include <memory>
 #include <string>
 
+#include "live_view.hpp"
 #include "view_content.hpp"
 
 namespace featsense::app {
@@ -26,6 +30,8 @@ class ViewServer {
   /// Reads three.js and its controls from `three_folder`; throws ViewError naming the file
   /// that is missing (and the package that brings it).
   ViewServer(ViewContent content, const std::filesystem::path& three_folder);
+  /// Serves a live run's map as it grows (`featsense live --view`).
+  ViewServer(std::shared_ptr<const LiveView> live, const std::filesystem::path& three_folder);
   ~ViewServer();
   ViewServer(const ViewServer&) = delete;
   ViewServer& operator=(const ViewServer&) = delete;
@@ -40,6 +46,8 @@ class ViewServer {
 
  private:
   struct Impl;
+  /// The page and three.js; `home` is the page served at /.
+  void serve_page(const std::filesystem::path& three_folder, const std::string& home);
   std::unique_ptr<Impl> impl_;
 };
 

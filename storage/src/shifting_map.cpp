@@ -83,24 +83,25 @@ void copy_brick_from_chunk(const Chunk& chunk, Index3 corner, uint32_t* brick_vo
 }
 
 /// Copies the voxels of `brick` (brick order) that lie in the block of `dim` voxels from global
-/// voxel `origin` into the block's x-fastest array.
+/// voxel `origin` into the block's x-fastest array, a row of up to 8 voxels at a time.
 void copy_brick_into_block(const uint32_t* brick_voxels, Index3 brick, Index3 origin, Index3 dim,
                            std::vector<uint32_t>& block) {
   const Index3 first = tsdf::LocalMapGeometry::first_voxel_of_brick(brick);
+  const int32_t x_begin = std::max(0, origin.x - first.x);
+  const int32_t x_end = std::min(kBrickSize, origin.x + dim.x - first.x);
+  if (x_begin >= x_end) return;
   for (int32_t z = 0; z < kBrickSize; ++z) {
     const int32_t bz = first.z + z - origin.z;
     if (bz < 0 || bz >= dim.z) continue;
     for (int32_t y = 0; y < kBrickSize; ++y) {
       const int32_t by = first.y + y - origin.y;
       if (by < 0 || by >= dim.y) continue;
-      for (int32_t x = 0; x < kBrickSize; ++x) {
-        const int32_t bx = first.x + x - origin.x;
-        if (bx < 0 || bx >= dim.x) continue;
-        block[static_cast<size_t>(bx) +
-              static_cast<size_t>(dim.x) * (static_cast<size_t>(by) +
-                                            static_cast<size_t>(dim.y) * static_cast<size_t>(bz))] =
-            brick_voxels[(z * kBrickSize + y) * kBrickSize + x];
-      }
+      const size_t row = static_cast<size_t>(first.x + x_begin - origin.x) +
+                         static_cast<size_t>(dim.x) * (static_cast<size_t>(by) +
+                                                       static_cast<size_t>(dim.y) *
+                                                           static_cast<size_t>(bz));
+      std::copy_n(brick_voxels + (z * kBrickSize + y) * kBrickSize + x_begin, x_end - x_begin,
+                  block.data() + row);
     }
   }
 }

@@ -28,13 +28,6 @@ namespace {
 constexpr const char* kOs1Pcap = "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap";
 constexpr const char* kOs1Json = "ouster/OS-1-128_v2.3.0_1024x10.json";
 
-std::string text_of(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 /// Waits until `log` contains `what` (false: the child ended first, or 30 s passed).
 bool wait_for_line(const std::filesystem::path& log, const std::string& what, pid_t child) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
@@ -45,12 +38,6 @@ bool wait_for_line(const std::filesystem::path& log, const std::string& what, pi
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return false;
-}
-
-int wait_exit_code(pid_t child) {
-  int status = 0;
-  waitpid(child, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 TEST(CliLive, AReplayedRecordingMapsAsTheRecordingDoes) {

@@ -2,14 +2,18 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "app/view_test_folder.hpp"
 #include "common/test_data.hpp"
 #include "featsense/viewer_export/viewer_mesh_binary.hpp"
+#include "live_view.hpp"
 #include "view_content.hpp"
 #include "view_server.hpp"
 
@@ -33,6 +37,12 @@ class RunningServer {
  public:
   explicit RunningServer(app::ViewContent content, const fs::path& three = app::kThreeJsFolder)
       : server_(std::move(content), three),
+        port_(server_.bind("127.0.0.1", 0)),
+        thread_([this] { server_.run(); }),
+        client_("127.0.0.1", port_) {}
+  /// Serving a live run's view.
+  explicit RunningServer(std::shared_ptr<const app::LiveView> live)
+      : server_(std::move(live), app::kThreeJsFolder),
         port_(server_.bind("127.0.0.1", 0)),
         thread_([this] { server_.run(); }),
         client_("127.0.0.1", port_) {}
@@ -186,6 +196,95 @@ TEST(ViewServer, APortInUseIsAnError) {
   } catch (const app::ViewError& e) {
     EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
   }
+}
+
+/// A preview refresh with one chunk's mesh (a triangle, or none) and a pose at x.
+mapping::MapPreview preview_of(const storage::ChunkKey& key, bool surface, double x) {
+  mapping::MapPreview preview;
+  mapping::ChunkMesh chunk;
+  chunk.key = key;
+  if (surface) {
+    chunk.mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    chunk.mesh.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    chunk.mesh.triangles = {{0, 1, 2}};
+  }
+  preview.chunks.push_back(chunk);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation().x() = x;
+  preview.new_poses.push_back(static_cast<int64_t>(x * 1e9), pose);
+  preview.latest_pose = pose;
+  preview.has_latest_pose = true;
+  preview.frames_read = preview.frames_mapped = static_cast<size_t>(x);
+  return preview;
+}
+
+/// The chunks of a /live/mesh.bin answer: key -> mesh bytes.
+std::map<std::array<int32_t, 3>, size_t> live_chunks(const std::string& body, uint32_t* version) {
+  std::map<std::array<int32_t, 3>, size_t> chunks;
+  EXPECT_EQ(body.compare(0, 8, std::string(app::kLiveMeshMagic, 8)), 0);
+  *version = u32_at(body, 8);
+  const uint32_t count = u32_at(body, 12);
+  size_t offset = 16;
+  for (uint32_t i = 0; i < count; ++i) {
+    const std::array<int32_t, 3> key = {static_cast<int32_t>(u32_at(body, offset)),
+                                        static_cast<int32_t>(u32_at(body, offset + 4)),
+                                        static_cast<int32_t>(u32_at(body, offset + 8))};
+    const uint32_t length = u32_at(body, offset + 12);
+    chunks[key] = length;
+    offset += 16 + length;
+  }
+  EXPECT_EQ(offset, body.size());
+  return chunks;
+}
+
+TEST(ViewServer, ALiveRunServesOnlyTheChunksChangedSinceAVersion) {
+  if (!fs::is_directory(app::kThreeJsFolder)) GTEST_SKIP() << "libjs-three is not installed";
+  auto live = std::make_shared<app::LiveView>("drive");
+  RunningServer server(live);
+  httplib::Client& client = server.client();
+  const auto page = client.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_NE(page->body.find("live.js"), std::string::npos);
+
+  live->take(preview_of({0, 0, 0}, true, 1.0));
+  live->take(preview_of({1, -2, 0}, true, 2.0));
+  live->take(preview_of({0, 0, 0}, false, 3.0));  // its surface carved away
+
+  uint32_t version = 0;
+  const auto all = client.Get("/live/mesh.bin?since=0");
+  ASSERT_TRUE(all);
+  const auto everything = live_chunks(all->body, &version);
+  EXPECT_EQ(version, 3u);
+  ASSERT_EQ(everything.size(), 2u);
+  EXPECT_EQ(everything.at({0, 0, 0}), 0u) << "a chunk without surface comes as an empty one";
+  EXPECT_EQ(everything.at({1, -2, 0}), viewer_export::viewer_mesh_bytes(3, 1, 0));
+
+  const auto since_two = client.Get("/live/mesh.bin?since=2");
+  ASSERT_TRUE(since_two);
+  const auto changed = live_chunks(since_two->body, &version);
+  EXPECT_EQ(changed.size(), 1u);
+  EXPECT_EQ(changed.count({0, 0, 0}), 1u);
+  EXPECT_TRUE(live_chunks(client.Get("/live/mesh.bin?since=3")->body, &version).empty());
+
+  const auto status = client.Get("/live/status.json?path_from=1");
+  ASSERT_TRUE(status);
+  const nlohmann::json s = nlohmann::json::parse(status->body);
+  EXPECT_EQ(s["name"], "drive");
+  EXPECT_EQ(s["version"], 3);
+  EXPECT_EQ(s["triangles"], 1);
+  EXPECT_EQ(s["path_length"], 3);
+  ASSERT_EQ(s["path_m"].size(), 2u);
+  EXPECT_EQ(s["path_m"][0][0], 2.0);
+  EXPECT_EQ(s["pose"]["position_m"][0], 3.0);
+  EXPECT_EQ(s["finished"], false);
+  live->set_finished();
+  EXPECT_EQ(nlohmann::json::parse(client.Get("/live/status.json")->body)["finished"], true);
+  // A path_from that is not a count is the whole path.
+  EXPECT_EQ(
+      nlohmann::json::parse(client.Get("/live/status.json?path_from=x")->body)["path_m"].size(),
+      3u);
+  // The files of a finished map are not served from a live run.
+  EXPECT_EQ(client.Get("/mesh.bin")->status, 404);
 }
 
 }  // namespace

@@ -26,9 +26,10 @@ inline std::filesystem::path page_check_script() {
 }
 
 /// Loads `url`, waits until `ready_expr` (a JavaScript expression) is true when given, and
-/// writes a screenshot to `screenshot`.
+/// writes a screenshot to `screenshot`; `report_expr`'s value comes back as result["reported"].
 inline PageCheck run_page_check(const std::string& url, const std::string& screenshot,
-                                const std::string& ready_expr = "", int timeout_ms = 30000) {
+                                const std::string& ready_expr = "", int timeout_ms = 30000,
+                                const std::string& report_expr = "") {
   PageCheck check;
   if (std::system("command -v node >/dev/null 2>&1") != 0) {
     check.skipped = true;
@@ -39,6 +40,7 @@ inline PageCheck run_page_check(const std::string& url, const std::string& scree
                         "' --screenshot '" + screenshot + "' --timeout-ms " +
                         std::to_string(timeout_ms);
   if (!ready_expr.empty()) command += " --ready-expr '" + ready_expr + "'";
+  if (!report_expr.empty()) command += " --report-expr '" + report_expr + "'";
   command += " 2>&1 </dev/null";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return check;

@@ -9,12 +9,29 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 
 #include "common/run_command.hpp"
 
 namespace featsense::test {
+
+/// The text of a file (empty where it cannot be read): a child's log.
+inline std::string text_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Waits for the child to end; its exit status (-1 where a signal ended it).
+inline int wait_exit_code(pid_t child) {
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
 
 /// Starts `featsense ARGS` as a child process, its output into `log`; returns its pid.
 inline pid_t spawn_featsense(const std::string& args, const std::filesystem::path& log) {

@@ -6,7 +6,9 @@
 // playwright-core is not installed (`npm install` in this folder; Debian's `chromium`).
 //
 // Usage: node page_check.mjs --url URL --screenshot OUT.png [--timeout-ms N]
-//          [--ready-expr 'JS expression'] [--width W] [--height H]
+//          [--ready-expr 'JS expression'] [--report-expr 'JS expression'] [--width W] [--height H]
+// --report-expr's value (JSON-serializable) comes back as "reported", taken with the
+// screenshot.
 // `differing_fraction` is the share of pixels whose colour differs from the top-left pixel's
 // (the page's background): a drawn mesh shows as pixels that differ.
 import { existsSync, writeFileSync, mkdtempSync, rmSync } from 'node:fs';
@@ -17,7 +19,7 @@ import { inflateSync } from 'node:zlib';
 const SKIP = 77;
 
 function parseArgs(argv) {
-  const options = { timeoutMs: 30000, readyExpr: '', width: 1280, height: 800 };
+  const options = { timeoutMs: 30000, readyExpr: '', reportExpr: '', width: 1280, height: 800 };
   for (let i = 0; i < argv.length; i += 2) {
     const [key, value] = [argv[i], argv[i + 1]];
     if (value === undefined) throw new Error(`${key} needs a value`);
@@ -25,6 +27,7 @@ function parseArgs(argv) {
     else if (key === '--screenshot') options.screenshot = value;
     else if (key === '--timeout-ms') options.timeoutMs = Number(value);
     else if (key === '--ready-expr') options.readyExpr = value;
+    else if (key === '--report-expr') options.reportExpr = value;
     else if (key === '--width') options.width = Number(value);
     else if (key === '--height') options.height = Number(value);
     else throw new Error(`unknown option ${key}`);
@@ -137,6 +140,7 @@ try {
     await page.waitForFunction(options.readyExpr, null, { timeout: options.timeoutMs });
   result.load_ms = Math.round(performance.now() - start);
   result.loaded = true;
+  if (options.reportExpr) result.reported = await page.evaluate(options.reportExpr);
   const png = await page.screenshot({ fullPage: false });
   writeFileSync(options.screenshot, png);
   result.differing_fraction = differingFraction(decodePng(png));

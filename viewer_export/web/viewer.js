@@ -64,23 +64,12 @@
   }
 
   // --- Colour maps: each turns a vertex into r, g, b in 0..255.
-  function ramp(stops, t) {
-    const x = Math.min(Math.max(t, 0), 1) * (stops.length - 1);
-    const i = Math.min(Math.floor(x), stops.length - 2);
-    const f = x - i;
-    const a = stops[i];
-    const b = stops[i + 1];
-    return [a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f, a[2] + (b[2] - a[2]) * f];
-  }
-  const HEIGHT_STOPS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
+  const ramp = featsenseMapScene.ramp;
+  const cssGradient = featsenseMapScene.cssGradient;
+  const HEIGHT_STOPS = featsenseMapScene.HEIGHT_STOPS;
   const ERROR_STOPS = [[0, 0, 255], [255, 255, 255], [255, 0, 0]];
   const COST_STOPS = [[0, 255, 0], [255, 255, 0], [255, 0, 0]];
   const NO_VALUE = [128, 128, 128];
-
-  function cssGradient(stops) {
-    return 'linear-gradient(to right, ' +
-        stops.map(function (s) { return 'rgb(' + s.join(',') + ')'; }).join(', ') + ')';
-  }
 
   // The height range: the 1st to 99th percentile of a sample, so that a few stray vertices
   // (a reflection, a bird) do not flatten the colours of the rest.
@@ -140,20 +129,10 @@
 
   // --- The scene
   const container = document.getElementById('scene');
-  const renderer = new THREE.WebGLRenderer({ antialias: false });
-  renderer.setPixelRatio(window.devicePixelRatio);
-  renderer.setSize(container.clientWidth, container.clientHeight);
-  renderer.setClearColor(0x20242a);
-  renderer.localClippingEnabled = true;
-  container.appendChild(renderer.domElement);
-
-  const scene = new THREE.Scene();
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x606060, 1.0));
-  const sun = new THREE.DirectionalLight(0xffffff, 0.5);
-  sun.position.set(0.4, 0.7, 1.0);
-  scene.add(sun);
-  const camera = new THREE.PerspectiveCamera(50, container.clientWidth / container.clientHeight, 0.01, 1000);
-  camera.up.set(0, 0, 1);
+  const view = featsenseMapScene.create(container, 1000);
+  const renderer = view.renderer;
+  const scene = view.scene;
+  const camera = view.camera;
   const cutPlane = new THREE.Plane(new THREE.Vector3(0, 0, -1), 1e9);
 
   let renderPending = false;
