@@ -343,11 +343,14 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
                 mapped.frames_mapped, mapped.wall_s, mapped.scans_per_s(), mapped.backend.c_str(),
                 mapped.map_chunks, mapped.map.shifts, out.string().c_str());
     const mapping::RealTimeCounts& kept_up = mapped.real_time;
-    if (kept_up.scans_dropped() + kept_up.integrations_skipped + kept_up.keyframes_skipped > 0) {
+    if (kept_up.scans_dropped() + kept_up.integrations_skipped + kept_up.keyframes_skipped +
+            kept_up.refinement_clouds_skipped >
+        0) {
       std::printf(
-          "to keep up: %zu integrations skipped (poses kept), %zu scans dropped, %zu "
-          "keyframes skipped\n",
-          kept_up.integrations_skipped, kept_up.scans_dropped(), kept_up.keyframes_skipped);
+          "to keep up: %zu integrations skipped (poses kept), %zu refinement clouds skipped, "
+          "%zu scans dropped, %zu keyframes skipped\n",
+          kept_up.integrations_skipped, kept_up.refinement_clouds_skipped, kept_up.scans_dropped(),
+          kept_up.keyframes_skipped);
     }
   }
   return {out, report};

@@ -35,6 +35,7 @@ nlohmann::json map_report_json(const config::Config& config, const slam::SourceI
                           {{"odometry_behind", run.real_time.scans_dropped_odometry_behind},
                            {"refinement_behind", run.real_time.scans_dropped_refinement_behind}}},
                          {"integrations_skipped", run.real_time.integrations_skipped},
+                         {"refinement_clouds_skipped", run.real_time.refinement_clouds_skipped},
                          {"keyframes_skipped", run.real_time.keyframes_skipped}};
   report["backend"] = run.backend;
   report["backend_reason"] = run.backend_reason;

@@ -30,6 +30,9 @@ def figures(work, name):
         'latency': {k: timing(v) for k, v in t.get('latency', {}).items()},
         'locate': timing(t['locate']),
         'integrate': timing(t['integrate']),
+        # live --view: the mapping thread's copies per refresh (the meshing is apart).
+        'preview': dict(timing(t['preview']), count=t['preview'].get('count', 0))
+                   if t.get('preview', {}).get('count') else None,
         'ate_m': {k: round(ape[k], 4) for k in ('mean', 'rmse', 'max') if k in ape},
         'mesh_aligned_m': {k: round(aligned[k], 4) for k in ('mean_abs', 'median', 'p95')
                            if k in aligned},

@@ -4,9 +4,10 @@
 # loopback on the CUDA backend (test/bench/live_replay.sh). The simulated town drive is made
 # there, replayed at 1x while `featsense live` maps it, and mapped offline from the same pcap;
 # the figures, one JSON line per run (live_figures.py), go to $OUT.
-#   run_gpu_live.sh [ouster] [vlp32c] [offline]   (default: all three steps)
-# ouster: the OS1-128 drive live; vlp32c: a VLP-32C's drive live; offline: both pcaps mapped by
-# `featsense map`.
+#   run_gpu_live.sh [ouster] [view] [vlp32c] [offline]   (default: ouster vlp32c offline)
+# ouster: the OS1-128 drive live; view: the same with the live page served and asked for its
+# changes every second (live_replay.sh --view); vlp32c: a VLP-32C's drive live; offline: both
+# pcaps mapped by `featsense map`.
 set -uo pipefail
 steps=${*:-ouster vlp32c offline}
 tar xJf .device/bundle.tar.xz -C /tmp
@@ -28,6 +29,9 @@ for step in $steps; do
   case $step in
     ouster) bash test/bench/live_replay.sh "$work" gpu_live --backend cuda
             runs+=(gpu_live) ;;
+    view) bash test/bench/live_replay.sh "$work" gpu_live_view --backend cuda --view
+          cp "$work/gpu_live_view.view.json" "$out/" 2>/dev/null
+          runs+=(gpu_live_view) ;;
     vlp32c) bash test/bench/live_replay.sh "$work" gpu_live_vlp32c --backend cuda --velodyne vlp32c
             runs+=(gpu_live_vlp32c) ;;
     offline) [ -f "$work/town_drive/recording.pcap" ] && offline gpu_offline "$work/town_drive" &&

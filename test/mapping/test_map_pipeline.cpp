@@ -15,6 +15,7 @@
 #include "featsense/mapping/map_pipeline.hpp"
 #include "featsense/mapping/mapper.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
+#include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "mapping/mapping_test_scenes.hpp"
 
 namespace featsense::mapping {
@@ -206,6 +207,52 @@ TEST(MapPipeline, InRealTimeATsdfThatFallsBehindSkipsIntegrationsKeepingEveryPos
   EXPECT_FALSE(read_chunks(dir / "map.h5").empty());
   storage::Hdf5ChunkStore store(dir / "map.h5");
   EXPECT_EQ(store.read_trajectory().size(), placed);
+}
+
+TEST(MapPipeline, ARefinementBehindMakesNoCloudsAndKeepsTheLastCorrection) {
+  // Step 3 of the real-time policy, stage by stage: the refinement told it is behind takes
+  // each scan without its cloud; its stretches pass unregistered, every scan comes out once,
+  // in order, at the pose it came with (the correction so far: none, with true poses).
+  const std::filesystem::path dir = test::scratch_dir("pipeline_refinement_behind");
+  const slam::BoxRoomSettings room = small_scans_room(24);
+  config::Config config = test::small_map_config();
+  const auto locator = slam::make_given_pose_locator(test::room_path(room), true);
+  PassSettings settings = real_time_pass();
+  slam::refine::RefineSettings refine;
+  refine.distance_m = 0.3;
+  refine.max_scans = 6;
+  settings.refine = refine;
+  MapPass pass(*locator, settings, config, room.sensor,
+               {dir / "map.h5", room.sensor.name, std::nullopt, false, {}, nullptr}, {});
+  const std::unique_ptr<slam::ScanSource> source = slam::make_box_room_source(room);
+  std::vector<PlacedScan> released;
+  const auto keep = [&](std::vector<PlacedScan> scans) {
+    for (PlacedScan& scan : scans) released.push_back(std::move(scan));
+  };
+  while (std::optional<slam::Scan> scan = source->next()) {
+    std::optional<PlacedScan> placed = pass.locate(std::move(*scan));
+    ASSERT_TRUE(placed);
+    keep(pass.refine(std::move(*placed), /*behind=*/true));
+  }
+  keep(pass.finish_refinement());
+  ASSERT_EQ(released.size(), 24u);
+  for (size_t k = 1; k < released.size(); ++k)
+    EXPECT_GT(released[k].placement.stamp_ns, released[k - 1].placement.stamp_ns);
+  for (PlacedScan& scan : released) {
+    const std::optional<LocatedScan> located = pass.make_rays(std::move(scan));
+    ASSERT_TRUE(located);
+    pass.integrate(*located);
+  }
+  const PassResult result = pass.close();
+  // Only the first scan (which fixes the frame) had its cloud made.
+  EXPECT_GT(result.real_time.refinement_clouds_skipped, 5u);
+  EXPECT_EQ(result.refine.refined, 0u) << "a stretch without clouds is not registered";
+  const slam::PoseInterpolator truth(test::room_path(room));
+  for (size_t k = 0; k < result.poses.size(); ++k) {
+    const std::optional<Eigen::Isometry3d> expected = truth.at(result.poses.stamps_ns[k]);
+    ASSERT_TRUE(expected);
+    EXPECT_LT((expected->translation() - result.poses.poses[k].translation()).norm(), 1e-6) << k;
+  }
 }
 
 TEST(MapPipeline, WithoutRealTimeNothingIsSkippedHoweverSlowAStage) {

@@ -129,7 +129,7 @@ std::vector<PlacedScan> MapPass::release(std::vector<slam::ScanPlacement> final)
   return out;
 }
 
-std::vector<PlacedScan> MapPass::refine(PlacedScan placed) {
+std::vector<PlacedScan> MapPass::refine(PlacedScan placed, bool behind) {
   if (!refiner_) {
     std::vector<PlacedScan> out;
     out.push_back(std::move(placed));
@@ -137,7 +137,7 @@ std::vector<PlacedScan> MapPass::refine(PlacedScan placed) {
   }
   const Clock::time_point start = Clock::now();
   result_.unrefined_poses->push_back(placed.placement.stamp_ns, placed.placement.T_map_sensor);
-  std::vector<slam::ScanPlacement> final = refiner_->add(placed.scan, placed.placement);
+  std::vector<slam::ScanPlacement> final = refiner_->add(placed.scan, placed.placement, behind);
   held_.push_back(std::move(placed));
   result_.refine_most_held = std::max(result_.refine_most_held, held_.size());
   std::vector<PlacedScan> out = release(std::move(final));
@@ -336,6 +336,7 @@ PassResult MapPass::close() {
     result_.real_time.scans_dropped_odometry_behind = dropped_odometry_behind_.load();
     result_.real_time.scans_dropped_refinement_behind = dropped_refinement_behind_.load();
     if (loops_) result_.real_time.keyframes_skipped = loops_->keyframes_skipped();
+    if (refiner_) result_.real_time.refinement_clouds_skipped = refiner_->clouds_skipped();
     result_.wall_s = std::chrono::duration<double>(Clock::now() - started_).count();
     result_.interrupted = events_.stop.stop_requested();
     if (!result_.poses.empty()) {

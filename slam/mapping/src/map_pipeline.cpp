@@ -129,10 +129,13 @@ bool push_all(std::vector<PlacedScan> scans, BoundedQueue<PlacedScan>& out) {
 }
 
 /// The refinement holds each stretch's scans until their poses are final; the queue before
-/// it is deep enough that the odometry does not wait while a stretch is registered.
+/// it is deep enough that the odometry does not wait while a stretch is registered. Real
+/// time: with its queue half full it makes no clouds (step 3 of the policy), so that it
+/// catches up rather than hold the odometry up.
 void refine_scans(MapPass& pass, BoundedQueue<PlacedScan>& in, BoundedQueue<PlacedScan>& out) {
   while (std::optional<PlacedScan> placed = in.pop()) {
-    if (!push_all(pass.refine(std::move(*placed)), out)) break;
+    const bool behind = pass.real_time() && 2 * in.size() >= in.capacity();
+    if (!push_all(pass.refine(std::move(*placed), behind), out)) break;
   }
   // The end of the input, or a stop: the last stretch is refined and mapped too.
   push_all(pass.finish_refinement(), out);

@@ -11,7 +11,8 @@ namespace featsense::slam::refine {
 PlacementRefiner::PlacementRefiner(const RefineSettings& settings)
     : settings_(settings), refiner_(settings) {}
 
-std::vector<ScanPlacement> PlacementRefiner::add(const Scan& scan, ScanPlacement placement) {
+std::vector<ScanPlacement> PlacementRefiner::add(const Scan& scan, ScanPlacement placement,
+                                                 bool without_cloud) {
   std::vector<ScanPlacement> out;
   if (!started_) {
     started_ = true;
@@ -33,18 +34,18 @@ std::vector<ScanPlacement> PlacementRefiner::add(const Scan& scan, ScanPlacement
                                                 motion_fraction(motion, t / period_s));
       });
     }
-    hold(*first_scan_, std::move(first), out);
+    hold(*first_scan_, std::move(first), false, out);
     first_scan_.reset();
     first_placement_.reset();
   }
-  hold(scan, std::move(placement), out);
+  hold(scan, std::move(placement), without_cloud, out);
   return out;
 }
 
 std::vector<ScanPlacement> PlacementRefiner::finish() {
   std::vector<ScanPlacement> out;
   if (first_scan_) {
-    hold(*first_scan_, std::move(*first_placement_), out);
+    hold(*first_scan_, std::move(*first_placement_), false, out);
     first_scan_.reset();
     first_placement_.reset();
   }
@@ -52,10 +53,13 @@ std::vector<ScanPlacement> PlacementRefiner::finish() {
   return out;
 }
 
-void PlacementRefiner::hold(const Scan& scan, ScanPlacement placement,
+void PlacementRefiner::hold(const Scan& scan, ScanPlacement placement, bool without_cloud,
                             std::vector<ScanPlacement>& out) {
   GaussianCloud cloud;
-  if (refiner_.needs_cloud(placement.T_map_sensor)) {
+  const bool needs_cloud = refiner_.needs_cloud(placement.T_map_sensor);
+  if (needs_cloud && without_cloud) {
+    ++clouds_skipped_;
+  } else if (needs_cloud) {
     const auto start = std::chrono::steady_clock::now();
     cloud = refinement_cloud(scan, placement, settings_.voxel_m, settings_.neighbours);
     cloud_ms_.push_back(

@@ -62,6 +62,13 @@ class BoundedQueue {
     return items_.size() >= capacity_;
   }
 
+  /// Items waiting now.
+  size_t size() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return items_.size();
+  }
+  size_t capacity() const { return capacity_; }
+
   /// Waits for an item; nullopt once the queue is closed and empty.
   std::optional<T> pop() {
     std::unique_lock<std::mutex> lock(mutex_);

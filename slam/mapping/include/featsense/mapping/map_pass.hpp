@@ -121,7 +121,8 @@ class MapPass {
   /// The front end: mixed pixels dropped, the scan placed. Nullopt: skipped (counted, warned).
   std::optional<PlacedScan> locate(slam::Scan scan, std::string* why = nullptr);
   /// The refinement: the scans whose poses became final, in order (at once without it).
-  std::vector<PlacedScan> refine(PlacedScan placed);
+  /// `behind` (the real-time policy): the refinement makes no cloud of this scan.
+  std::vector<PlacedScan> refine(PlacedScan placed, bool behind = false);
   /// The end of the input (or a stop): the last stretch refined (nothing the second time).
   std::vector<PlacedScan> finish_refinement();
   /// The loop closure sees the scan; its rays are made (not with `skip_integration`: the

@@ -19,7 +19,10 @@
 //      long as it needs, and no rays are made for the others.
 //   2. The loop closure falls behind (8 keyframes queued): keyframes are skipped.
 //   3. The refinement falls behind: its queue (16 x queue_capacity scans) absorbs a stretch
-//      that takes long; once full, the odometry waits for it, and then step 4 drops scans.
+//      that takes long; half full, the refinement makes no clouds of the scans it takes, so
+//      that a stretch without them passes with the last stretch's correction, unregistered,
+//      and the queue drains; only once it is full all the same the odometry waits for it, and
+//      then step 4 drops scans.
 //   4. Last resort, the odometry falls behind (its queue of queue_capacity scans full): the
 //      oldest waiting scan is dropped unplaced, so the freshest scan is the next one placed.
 // The reader never waits, so the sensor's packets are never left in the socket buffers.

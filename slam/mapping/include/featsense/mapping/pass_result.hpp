@@ -47,6 +47,9 @@ struct RealTimeCounts {
   size_t scans_dropped_refinement_behind = 0;
   /// Scans placed (their poses kept) but not integrated: the TSDF was behind.
   size_t integrations_skipped = 0;
+  /// Scans the refinement took without making their clouds: it was behind. A stretch left
+  /// without clouds keeps the last stretch's correction instead of being registered.
+  size_t refinement_clouds_skipped = 0;
   /// Keyframes the loop closure did not get: its thread was behind.
   size_t keyframes_skipped = 0;
 

@@ -20,8 +20,11 @@ class PlacementRefiner {
   explicit PlacementRefiner(const RefineSettings& settings);
 
   /// Takes the next placed scan (the scan is read, not kept) and gives the placements that
-  /// became final with it, oldest first: none while a stretch fills.
-  std::vector<ScanPlacement> add(const Scan& scan, ScanPlacement placement);
+  /// became final with it, oldest first: none while a stretch fills. `without_cloud`: the
+  /// caller is behind (a live sensor), so no cloud is made for the scan; a stretch without
+  /// clouds passes with the last stretch's correction instead of a registration.
+  std::vector<ScanPlacement> add(const Scan& scan, ScanPlacement placement,
+                                 bool without_cloud = false);
 
   /// The placements still held, refined as a last, shorter stretch.
   std::vector<ScanPlacement> finish();
@@ -30,9 +33,12 @@ class PlacementRefiner {
   const RefineCounts& counts() const { return refiner_.counts(); }
   /// Per cloud made: milliseconds.
   const std::vector<double>& cloud_ms() const { return cloud_ms_; }
+  /// Clouds the refinement would have made but was told to go without.
+  size_t clouds_skipped() const { return clouds_skipped_; }
 
  private:
-  void hold(const Scan& scan, ScanPlacement placement, std::vector<ScanPlacement>& out);
+  void hold(const Scan& scan, ScanPlacement placement, bool without_cloud,
+            std::vector<ScanPlacement>& out);
   void release(std::vector<ScanPlacement>& out);
 
   RefineSettings settings_;
@@ -43,6 +49,7 @@ class PlacementRefiner {
   std::optional<ScanPlacement> first_placement_;
   bool started_ = false;
   std::vector<double> cloud_ms_;
+  size_t clouds_skipped_ = 0;
 };
 
 }  // namespace featsense::slam::refine
