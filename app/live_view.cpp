@@ -47,6 +47,8 @@ void LiveView::take(mapping::MapPreview preview) {
   for (auto& [key, entry] : encoded) {
     ChunkEntry& kept = chunks_[key];
     triangles_ = triangles_ - kept.triangles + entry.triangles;
+    chunks_with_surface_ =
+        chunks_with_surface_ - (kept.triangles > 0 ? 1 : 0) + (entry.triangles > 0 ? 1 : 0);
     entry.version = version_;
     kept = std::move(entry);
   }
@@ -71,7 +73,7 @@ nlohmann::json LiveView::status(size_t path_from) const {
   status["pose_latency_ms"] = milliseconds(latest_.pose_latency_ms);
   status["integration_latency_ms"] = milliseconds(latest_.integration_latency_ms);
   status["meshing_ms"] = milliseconds(latest_.meshing_ms);
-  status["chunks"] = chunks_.size();
+  status["chunks"] = chunks_with_surface_;  // those with a surface
   status["chunks_waiting"] = latest_.chunks_waiting;
   status["triangles"] = triangles_;
   if (latest_.has_latest_pose) {

@@ -54,6 +54,7 @@ class LiveView {
   uint64_t version_ = 0;
   std::map<storage::ChunkKey, ChunkEntry> chunks_;
   size_t triangles_ = 0;
+  size_t chunks_with_surface_ = 0;
   std::vector<float> path_;     ///< x, y, z of each final pose
   mapping::MapPreview latest_;  ///< without chunks and poses
   bool finished_ = false;

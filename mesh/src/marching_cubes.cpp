@@ -166,7 +166,7 @@ TriangleMesh extract_mesh(const std::vector<uint32_t>& voxels, tsdf::Index3 orig
 
 static_assert(kPaddedChunkSize == internal::kPaddedSize);
 
-TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t> padded,
+TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t>& padded,
                                 double voxel_size_m, double min_weight) {
   if (padded.size() != internal::kPaddedVoxels) {
     throw std::invalid_argument("a chunk's padded block holds " +
@@ -184,8 +184,9 @@ TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32
   parameters.min_weight_fixed = min_weight_fixed(min_weight);
   internal::PaddedBlock block;
   block.key = key;
-  block.voxels = std::move(padded);
+  block.voxels.swap(padded);
   internal::ChunkMesh part = internal::mesh_chunk(block, parameters);
+  block.voxels.swap(padded);
   TriangleMesh mesh;
   mesh.vertices = std::move(part.vertices);
   mesh.normals = std::move(part.normals);

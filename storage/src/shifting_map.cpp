@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace featsense::storage {
 namespace {
@@ -96,10 +97,10 @@ void copy_brick_into_block(const uint32_t* brick_voxels, Index3 brick, Index3 or
     for (int32_t y = 0; y < kBrickSize; ++y) {
       const int32_t by = first.y + y - origin.y;
       if (by < 0 || by >= dim.y) continue;
-      const size_t row = static_cast<size_t>(first.x + x_begin - origin.x) +
-                         static_cast<size_t>(dim.x) * (static_cast<size_t>(by) +
-                                                       static_cast<size_t>(dim.y) *
-                                                           static_cast<size_t>(bz));
+      const size_t row =
+          static_cast<size_t>(first.x + x_begin - origin.x) +
+          static_cast<size_t>(dim.x) *
+              (static_cast<size_t>(by) + static_cast<size_t>(dim.y) * static_cast<size_t>(bz));
       std::copy_n(brick_voxels + (z * kBrickSize + y) * kBrickSize + x_begin, x_end - x_begin,
                   block.data() + row);
     }
@@ -193,32 +194,60 @@ void ShiftingMap::sync() {
 }
 
 void ShiftingMap::read_block(Index3 origin, Index3 dim, std::vector<uint32_t>& voxels) {
+  std::vector<std::vector<uint32_t>> blocks;
+  read_blocks({origin}, dim, blocks);
+  voxels = std::move(blocks.front());
+}
+
+void ShiftingMap::read_blocks(const std::vector<Index3>& origins, Index3 dim,
+                              std::vector<std::vector<uint32_t>>& blocks) {
   if (dim.x <= 0 || dim.y <= 0 || dim.z <= 0) throw std::invalid_argument("read_block: empty box");
-  voxels.assign(
-      static_cast<size_t>(dim.x) * static_cast<size_t>(dim.y) * static_cast<size_t>(dim.z),
-      tsdf::kUnobservedVoxel);
-  // Bricks lie wholly inside the local map or wholly outside it (both are whole bricks).
+  // Every brick any box reaches into, once, in a fixed order.
+  std::vector<Index3> bricks;
+  for (const Index3& origin : origins) {
+    for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z)
+      for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y)
+        for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x)
+          bricks.push_back({x, y, z});
+  }
+  const auto brick_less = [](const Index3& a, const Index3& b) {
+    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
+  };
+  std::sort(bricks.begin(), bricks.end(), brick_less);
+  bricks.erase(std::unique(bricks.begin(), bricks.end(),
+                           [](const Index3& a, const Index3& b) {
+                             return a.x == b.x && a.y == b.y && a.z == b.z;
+                           }),
+               bricks.end());
+  // Bricks lie wholly inside the local map or wholly outside it (both are whole bricks): the
+  // first from the integrator in one transfer, the others from the store.
   const tsdf::LocalMapGeometry& geometry = map_.geometry();
   std::vector<Index3> inside;
   std::vector<Index3> outside;
-  for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z) {
-    for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y) {
-      for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x) {
-        (geometry.contains_brick({x, y, z}) ? inside : outside).push_back({x, y, z});
-      }
-    }
-  }
-  std::vector<uint32_t> bricks;
-  if (!inside.empty()) {
-    map_.read_bricks(inside, bricks);
-    for (size_t k = 0; k < inside.size(); ++k)
-      copy_brick_into_block(bricks.data() + k * kBrickVoxels, inside[k], origin, dim, voxels);
-  }
-  if (!outside.empty()) {
-    load(outside, bricks);
-    for (size_t k = 0; k < outside.size(); ++k)
-      copy_brick_into_block(bricks.data() + k * kBrickVoxels, outside[k], origin, dim, voxels);
-  }
+  for (const Index3& b : bricks) (geometry.contains_brick(b) ? inside : outside).push_back(b);
+  std::vector<uint32_t>& inside_voxels = read_inside_;
+  std::vector<uint32_t>& outside_voxels = read_outside_;
+  if (!inside.empty()) map_.read_bricks(inside, inside_voxels);
+  if (!outside.empty()) load(outside, outside_voxels);
+  const auto voxels_of = [&](const Index3& b) -> const uint32_t* {
+    const bool in = geometry.contains_brick(b);
+    const std::vector<Index3>& list = in ? inside : outside;
+    const size_t k = static_cast<size_t>(std::lower_bound(list.begin(), list.end(), b, brick_less) -
+                                         list.begin());
+    return (in ? inside_voxels : outside_voxels).data() + k * kBrickVoxels;
+  };
+  const size_t voxel_count =
+      static_cast<size_t>(dim.x) * static_cast<size_t>(dim.y) * static_cast<size_t>(dim.z);
+  blocks.resize(origins.size());
+  tbb::parallel_for(size_t{0}, origins.size(), [&](size_t i) {
+    const Index3 origin = origins[i];
+    std::vector<uint32_t>& block = blocks[i];
+    block.assign(voxel_count, tsdf::kUnobservedVoxel);
+    for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z)
+      for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y)
+        for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x)
+          copy_brick_into_block(voxels_of({x, y, z}), {x, y, z}, origin, dim, block);
+  });
 }
 
 template <typename VoxelsOf>

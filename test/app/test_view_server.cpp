@@ -272,6 +272,7 @@ TEST(ViewServer, ALiveRunServesOnlyTheChunksChangedSinceAVersion) {
   EXPECT_EQ(s["name"], "drive");
   EXPECT_EQ(s["version"], 3);
   EXPECT_EQ(s["triangles"], 1);
+  EXPECT_EQ(s["chunks"], 1) << "the chunk whose surface is gone does not count";
   EXPECT_EQ(s["path_length"], 3);
   ASSERT_EQ(s["path_m"].size(), 2u);
   EXPECT_EQ(s["path_m"][0][0], 2.0);

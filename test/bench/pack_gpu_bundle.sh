@@ -23,3 +23,10 @@ rm -rf "$work"
 # The two real places for the scene runs of run_gpu_checks.sh.
 mkdir -p .device/scenes
 cp ../shared/data/scenes/small_house.ply ../shared/data/scenes/gas_station_with_ground.ply .device/scenes/ 2>/dev/null || true
+# three.js for `live --view` (run_gpu_live.sh view): the GPU machine lacks Debian's libjs-three.
+three=/usr/share/javascript/three
+if [ -d "$three" ]; then
+  mkdir -p .device/three/build .device/three/examples/js/controls
+  cp "$three/build/three.min.js" .device/three/build/
+  cp "$three"/examples/js/controls/{OrbitControls,FlyControls}.js .device/three/examples/js/controls/
+fi

@@ -29,7 +29,8 @@ for step in $steps; do
   case $step in
     ouster) bash test/bench/live_replay.sh "$work" gpu_live --backend cuda
             runs+=(gpu_live) ;;
-    view) bash test/bench/live_replay.sh "$work" gpu_live_view --backend cuda --view
+    view) bash test/bench/live_replay.sh "$work" gpu_live_view --backend cuda --view \
+            -- --three "${THREE:-.device/three}"
           cp "$work/gpu_live_view.view.json" "$out/" 2>/dev/null
           runs+=(gpu_live_view) ;;
     vlp32c) bash test/bench/live_replay.sh "$work" gpu_live_vlp32c --backend cuda --velodyne vlp32c

@@ -271,15 +271,17 @@ TEST(MarchingCubes, ChunkByChunkGivesTheStoresMesh) {
               voxel(key.x * storage::kChunkSize - 1 + x, key.y * storage::kChunkSize - 1 + y,
                     key.z * storage::kChunkSize - 1 + z);
         }
-    const mesh::TriangleMesh part = mesh::extract_chunk_mesh(key, std::move(padded), kVoxel, 0.5);
+    const std::vector<uint32_t> given = padded;
+    const mesh::TriangleMesh part = mesh::extract_chunk_mesh(key, padded, kVoxel, 0.5);
+    ASSERT_EQ(padded, given) << "the block comes back as it was";
     ASSERT_EQ(part.normals.size(), part.vertices.size());
     united = append_mesh(std::move(united), part);
   }
   const mesh::TriangleMesh whole = mesh::extract_mesh(store, {});
   ASSERT_GT(whole.triangles.size(), 1000u);
   EXPECT_EQ(triangle_corners(united), triangle_corners(whole));
-  EXPECT_THROW(mesh::extract_chunk_mesh({0, 0, 0}, std::vector<uint32_t>(64), kVoxel, 0.5),
-               std::invalid_argument);
+  std::vector<uint32_t> too_small(64);
+  EXPECT_THROW(mesh::extract_chunk_mesh({0, 0, 0}, too_small, kVoxel, 0.5), std::invalid_argument);
 }
 
 TEST(MarchingCubes, EmptyStoreAndBadSettings) {

@@ -269,6 +269,21 @@ TEST_P(ShiftingMapTest, ABlockReadWhileMappingIsTheWholeMapsVoxels) {
   }
   EXPECT_GT(observed, 50000u);
   EXPECT_EQ(differing, 0u);
+
+  // Several boxes at once (overlapping, one of them far outside) are each the box read alone;
+  // vectors handed in are reused.
+  const Index3 small{67, 67, 67};
+  const std::vector<Index3> origins = {{g.origin.x + 10, g.origin.y + 20, g.origin.z + 3},
+                                       {g.origin.x + 40, g.origin.y + 20, g.origin.z + 3},
+                                       {g.origin.x - 500, g.origin.y, g.origin.z}};
+  std::vector<std::vector<uint32_t>> blocks(1, std::vector<uint32_t>(7, 1u));
+  shifting.read_blocks(origins, small, blocks);
+  ASSERT_EQ(blocks.size(), origins.size());
+  for (size_t i = 0; i < origins.size(); ++i) {
+    std::vector<uint32_t> alone;
+    shifting.read_block(origins[i], small, alone);
+    EXPECT_EQ(blocks[i], alone) << i;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ShiftingMapTest, ::testing::Values("cpu", "cuda"));

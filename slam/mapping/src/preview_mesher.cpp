@@ -98,14 +98,17 @@ void PreviewMesher::refresh(storage::ShiftingMap* map, const Eigen::Vector3d& se
                       });
     keys.resize(count);
     constexpr int32_t n = mesh::kPaddedChunkSize;
-    job.blocks.resize(count);
-    for (size_t i = 0; i < count; ++i) {
-      const storage::ChunkKey& key = keys[i];
-      map->read_block({key.x * storage::kChunkSize - 1, key.y * storage::kChunkSize - 1,
-                       key.z * storage::kChunkSize - 1},
-                      {n, n, n}, job.blocks[i]);
+    std::vector<tsdf::Index3> origins;
+    for (const storage::ChunkKey& key : keys) {
+      origins.push_back({key.x * storage::kChunkSize - 1, key.y * storage::kChunkSize - 1,
+                         key.z * storage::kChunkSize - 1});
       changed_.erase(key);
     }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      job.blocks = std::move(spare_blocks_);
+    }
+    map->read_blocks(origins, {n, n, n}, job.blocks);
     job.keys = std::move(keys);
   }
   status.refresh = ++refreshes_;
@@ -153,7 +156,7 @@ void PreviewMesher::mesh_jobs() {
         tbb::parallel_for(size_t{0}, job.keys.size(), [&](size_t i) {
           job.preview.chunks[i].key = job.keys[i];
           job.preview.chunks[i].mesh = mesh::extract_chunk_mesh(
-              job.keys[i], std::move(job.blocks[i]), voxel_size_m_, settings_.min_weight);
+              job.keys[i], job.blocks[i], voxel_size_m_, settings_.min_weight);
         });
       });
       job.preview.meshing_ms =
@@ -165,6 +168,7 @@ void PreviewMesher::mesh_jobs() {
     }
 
     lock.lock();
+    spare_blocks_ = std::move(job.blocks);
     job_.reset();
     lock.unlock();
     wake_.notify_all();

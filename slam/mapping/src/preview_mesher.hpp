@@ -67,6 +67,8 @@ class PreviewMesher {
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::optional<Job> job_;  ///< waiting for, or being meshed by, the meshing thread
+  /// Blocks meshed already, kept for the next refresh's copies: their pages are mapped.
+  std::vector<std::vector<uint32_t>> spare_blocks_;
   bool stopping_ = false;
   std::thread thread_;
 };

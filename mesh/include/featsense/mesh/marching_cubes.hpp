@@ -63,9 +63,10 @@ inline constexpr int32_t kPaddedChunkSize = storage::kChunkSize + 3;
 /// key * 64 + 65 per axis, x fastest (kPaddedChunkSize^3 of them). The result holds the
 /// cubes whose lowest voxel lies in the chunk, with normals: the chunk's part of extract_mesh
 /// over a store of the same voxels, not welded to its neighbours' parts. For previews of a map
-/// being made, a chunk at a time. Throws std::invalid_argument for a block of another size or
-/// bad settings.
-TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t> padded,
+/// being made, a chunk at a time. `padded` is borrowed and given back as it was (its memory can
+/// hold the next block). Throws std::invalid_argument for a block of another size or bad
+/// settings.
+TriangleMesh extract_chunk_mesh(const storage::ChunkKey& key, std::vector<uint32_t>& padded,
                                 double voxel_size_m, double min_weight);
 
 }  // namespace featsense::mesh

@@ -47,6 +47,11 @@ class ShiftingMap {
   /// the store (unobserved where neither holds them). For a preview of the map while it is
   /// made; the store is only read.
   void read_block(tsdf::Index3 origin, tsdf::Index3 dim, std::vector<uint32_t>& voxels);
+  /// read_block for several boxes of one size at once: each brick is read once (one transfer
+  /// from the GPU, one read of each stored chunk) however many boxes it reaches into. The
+  /// vectors of `blocks` are reused where they are there already (no fresh pages to clear).
+  void read_blocks(const std::vector<tsdf::Index3>& origins, tsdf::Index3 dim,
+                   std::vector<std::vector<uint32_t>>& blocks);
 
   /// The centre of the local map, map frame, metres.
   tsdf::Vec3 centre_m() const;
@@ -66,7 +71,9 @@ class ShiftingMap {
   std::set<ChunkKey> keys_at_open_;                               ///< digests unknown
   std::unordered_map<ChunkKey, uint64_t, ChunkKeyHash> written_;  ///< digest of the last write
   ShiftingMapStats stats_;
-  tsdf::ShiftBuffers shift_buffers_;  ///< kept between shifts
+  tsdf::ShiftBuffers shift_buffers_;   ///< kept between shifts
+  std::vector<uint32_t> read_inside_;  ///< read_blocks' bricks, kept between calls
+  std::vector<uint32_t> read_outside_;
 };
 
 /// A 64-bit digest of a chunk's voxels, to tell whether a chunk changed since it was written.
