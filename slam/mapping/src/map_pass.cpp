@@ -226,7 +226,7 @@ void MapPass::integrate(LocatedScan scan) {
     result_.timings.flush_ms.push_back(ms_since(start));
     last_flush_ = Clock::now();
   }
-  if (preview_) preview_->mark(scan.rays);
+  if (preview_) preview_->mark(scan.rays, map.integrator().geometry());
   report_progress();
   update_preview(false);
 }

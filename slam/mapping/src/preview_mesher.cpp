@@ -44,15 +44,22 @@ PreviewMesher::~PreviewMesher() {
   thread_.join();
 }
 
-void PreviewMesher::mark(const tsdf::RayBatch& rays) {
+void PreviewMesher::mark(const tsdf::RayBatch& rays, const tsdf::LocalMapGeometry& bounds) {
   const double chunk_m = voxel_size_m_ * storage::kChunkSize;
   // A point changes voxels up to tau around it; the cubes of the chunk below meet a chunk's
   // first voxel, so a point within a voxel of a chunk's lower face changes that one too.
   const double below = truncation_m_ + voxel_size_m_;
   const double above = truncation_m_;
+  const auto margin = static_cast<float>(truncation_m_);
+  const tsdf::Vec3 lo_m = bounds.min_corner();
+  const tsdf::Vec3 hi_m = bounds.max_corner();
   storage::ChunkKey last{INT32_MIN, INT32_MIN, INT32_MIN};
   for (const tsdf::Vec3& p : rays.endpoints_m) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+    // NaN fails these too.
+    if (!(p.x >= lo_m.x - margin && p.x < hi_m.x + margin && p.y >= lo_m.y - margin &&
+          p.y < hi_m.y + margin && p.z >= lo_m.z - margin && p.z < hi_m.z + margin)) {
+      continue;
+    }
     const storage::ChunkKey lo{chunk_index(p.x - below, chunk_m), chunk_index(p.y - below, chunk_m),
                                chunk_index(p.z - below, chunk_m)};
     const storage::ChunkKey hi{chunk_index(p.x + above, chunk_m), chunk_index(p.y + above, chunk_m),

@@ -19,6 +19,7 @@
 #include "featsense/mapping/map_preview.hpp"
 #include "featsense/storage/chunk.hpp"
 #include "featsense/storage/shifting_map.hpp"
+#include "featsense/tsdf/local_map_geometry.hpp"
 #include "featsense/tsdf/ray_batch.hpp"
 
 namespace featsense::mapping {
@@ -32,8 +33,9 @@ class PreviewMesher {
   PreviewMesher& operator=(const PreviewMesher&) = delete;
 
   /// The chunks within the truncation distance of a scan's points (and those whose cubes
-  /// reach into them) have changed.
-  void mark(const tsdf::RayBatch& rays);
+  /// reach into them) have changed; points farther than that outside the local map `bounds`
+  /// (whose rays are clipped to it) change nothing.
+  void mark(const tsdf::RayBatch& rays, const tsdf::LocalMapGeometry& bounds);
   /// A pose made final (integrated or not).
   void add_pose(int64_t stamp_ns, const Eigen::Isometry3d& pose);
 
