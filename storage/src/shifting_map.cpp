@@ -83,6 +83,16 @@ void copy_brick_from_chunk(const Chunk& chunk, Index3 corner, uint32_t* brick_vo
   }
 }
 
+/// Calls f(brick) for every brick that the box of `dim` voxels from global voxel `origin`
+/// reaches into, x fastest.
+template <typename F>
+void for_each_brick_in_box(Index3 origin, Index3 dim, const F& f) {
+  for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z)
+    for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y)
+      for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x)
+        f(Index3{x, y, z});
+}
+
 /// Copies the voxels of `brick` (brick order) that lie in the block of `dim` voxels from global
 /// voxel `origin` into the block's x-fastest array, a row of up to 8 voxels at a time.
 void copy_brick_into_block(const uint32_t* brick_voxels, Index3 brick, Index3 origin, Index3 dim,
@@ -204,12 +214,8 @@ void ShiftingMap::read_blocks(const std::vector<Index3>& origins, Index3 dim,
   if (dim.x <= 0 || dim.y <= 0 || dim.z <= 0) throw std::invalid_argument("read_block: empty box");
   // Every brick any box reaches into, once, in a fixed order.
   std::vector<Index3> bricks;
-  for (const Index3& origin : origins) {
-    for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z)
-      for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y)
-        for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x)
-          bricks.push_back({x, y, z});
-  }
+  for (const Index3& origin : origins)
+    for_each_brick_in_box(origin, dim, [&](Index3 b) { bricks.push_back(b); });
   const auto brick_less = [](const Index3& a, const Index3& b) {
     return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
   };
@@ -243,10 +249,8 @@ void ShiftingMap::read_blocks(const std::vector<Index3>& origins, Index3 dim,
     const Index3 origin = origins[i];
     std::vector<uint32_t>& block = blocks[i];
     block.assign(voxel_count, tsdf::kUnobservedVoxel);
-    for (int32_t z = tsdf::brick_of(origin.z); z <= tsdf::brick_of(origin.z + dim.z - 1); ++z)
-      for (int32_t y = tsdf::brick_of(origin.y); y <= tsdf::brick_of(origin.y + dim.y - 1); ++y)
-        for (int32_t x = tsdf::brick_of(origin.x); x <= tsdf::brick_of(origin.x + dim.x - 1); ++x)
-          copy_brick_into_block(voxels_of({x, y, z}), {x, y, z}, origin, dim, block);
+    for_each_brick_in_box(
+        origin, dim, [&](Index3 b) { copy_brick_into_block(voxels_of(b), b, origin, dim, block); });
   });
 }
 
