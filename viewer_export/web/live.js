@@ -26,8 +26,7 @@
   // drawn: the triangles of the last frame on the screen.
   window.__featsenseLive = { refreshes: 0, triangles: 0, chunks: 0, version: 0, drawn: 0, ready: false };
 
-  // --- One chunk's mesh (viewer_export/include/featsense/viewer_export/viewer_mesh_binary.hpp)
-  const MESH_MAGIC = 'FSVIEW1';
+  // --- The changes' binary (app/live_view.hpp): chunk meshes in the viewer's binary
   const LIVE_MAGIC = 'FSLIVE1';
 
   function magicOf(buffer, offset) {
@@ -35,18 +34,8 @@
   }
 
   function parseChunkMesh(buffer, offset, length) {
-    if (magicOf(buffer, offset) !== MESH_MAGIC) throw new Error('a chunk is not a viewer mesh');
-    const header = new DataView(buffer, offset, 32);
-    const n = header.getUint32(8, true);
-    const m = header.getUint32(12, true);
-    const normalBytes = Math.ceil((3 * n) / 4) * 4;
-    if (32 + n * 12 + normalBytes + m * 12 !== length) throw new Error('a chunk mesh has the wrong size');
     // Copies: the views must not keep the whole response alive once it is parsed.
-    const positions = new Float32Array(buffer.slice(offset + 32, offset + 32 + n * 12));
-    const normals = new Int8Array(buffer.slice(offset + 32 + n * 12, offset + 32 + n * 12 + 3 * n));
-    const indexStart = offset + 32 + n * 12 + normalBytes;
-    const indices = new Uint32Array(buffer.slice(indexStart, indexStart + m * 12));
-    return { n: n, m: m, positions: positions, normals: normals, indices: indices };
+    return featsenseMapScene.parseViewerMesh(buffer, offset, length, [], 'a chunk mesh', true);
   }
 
   // --- Colours: height above the first pose, on a fixed ramp, so that a chunk keeps its
@@ -125,11 +114,11 @@
       triangles -= old.triangles;
       chunks.delete(id);
     }
-    if (!part || part.m === 0) return;
+    if (!part || part.triangleCount === 0) return;
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(part.positions, 3));
     geometry.setAttribute('normal', new THREE.BufferAttribute(part.normals, 3, true));
-    geometry.setAttribute('color', new THREE.BufferAttribute(heightColours(part.positions, part.n), 3, true));
+    geometry.setAttribute('color', new THREE.BufferAttribute(heightColours(part.positions, part.vertexCount), 3, true));
     geometry.setIndex(new THREE.BufferAttribute(part.indices, 1));
     geometry.computeBoundingSphere();
     geometry.computeBoundingBox();
@@ -138,8 +127,8 @@
     else if (!framed) firstMeshBox.union(geometry.boundingBox);
     const object = new THREE.Mesh(geometry, material);
     scene.add(object);
-    chunks.set(id, { object: object, triangles: part.m });
-    triangles += part.m;
+    chunks.set(id, { object: object, triangles: part.triangleCount });
+    triangles += part.triangleCount;
   }
 
   function applyChanges(buffer) {

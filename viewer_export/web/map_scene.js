@@ -1,5 +1,6 @@
-// What the viewer page (viewer.js) and the live page (live.js) share: the height colours and
-// a three.js scene in the map frame (Z up, metres) with its lights, camera and renderer.
+// What the viewer page (viewer.js) and the live page (live.js) share: the height colours, the
+// mesh binary's parser, and a three.js scene in the map frame (Z up, metres) with its lights,
+// camera and renderer.
 'use strict';
 
 window.featsenseMapScene = (function () {
@@ -19,6 +20,43 @@ window.featsenseMapScene = (function () {
   function cssGradient(stops) {
     return 'linear-gradient(to right, ' +
         stops.map(function (s) { return 'rgb(' + s.join(',') + ')'; }).join(', ') + ')';
+  }
+
+  // The viewer's mesh binary (viewer_export/include/featsense/viewer_export/viewer_mesh_binary.hpp).
+  const MESH_MAGIC = 'FSVIEW1';
+  const MESH_HEADER_BYTES = 32;
+
+  /// The mesh of `length` bytes at `offset` of `buffer`, its layers named by `layerNames`;
+  /// `name` says what it is in an error. `copy`: the arrays are copies, so that they do not
+  /// keep a larger response alive; else views into `buffer`.
+  function parseViewerMesh(buffer, offset, length, layerNames, name, copy) {
+    if (length < MESH_HEADER_BYTES) throw new Error(name + ' is too short');
+    const magic = String.fromCharCode.apply(null, new Uint8Array(buffer, offset, 7));
+    if (magic !== MESH_MAGIC) throw new Error(name + ' is not a featsense viewer mesh');
+    const header = new DataView(buffer, offset, MESH_HEADER_BYTES);
+    const n = header.getUint32(8, true);
+    const m = header.getUint32(12, true);
+    const k = header.getUint32(16, true);
+    const normalBytes = Math.ceil((3 * n) / 4) * 4;
+    const expected = MESH_HEADER_BYTES + n * (3 + k) * 4 + normalBytes + m * 12;
+    if (length !== expected) throw new Error(name + ' holds ' + length + ' bytes, expected ' + expected);
+    let at = offset + MESH_HEADER_BYTES;
+    const take = function (Type, count, bytes) {
+      const end = at + count * Type.BYTES_PER_ELEMENT;
+      const array = copy ? new Type(buffer.slice(at, end)) : new Type(buffer, at, count);
+      at += bytes || count * Type.BYTES_PER_ELEMENT;
+      return array;
+    };
+    const mesh = {
+      vertexCount: n,
+      triangleCount: m,
+      positions: take(Float32Array, 3 * n),
+      normals: take(Int8Array, 3 * n, normalBytes),  // times 127
+      indices: take(Uint32Array, 3 * m),
+      layers: {},
+    };
+    for (let i = 0; i < k; ++i) mesh.layers[layerNames[i]] = take(Float32Array, n);
+    return mesh;
   }
 
   /// A renderer filling `container` (clipping on), a scene lit from above, a camera whose up
@@ -41,5 +79,8 @@ window.featsenseMapScene = (function () {
     return { renderer: renderer, scene: scene, camera: camera };
   }
 
-  return { HEIGHT_STOPS: HEIGHT_STOPS, ramp: ramp, cssGradient: cssGradient, create: create };
+  return {
+    HEIGHT_STOPS: HEIGHT_STOPS, ramp: ramp, cssGradient: cssGradient,
+    parseViewerMesh: parseViewerMesh, create: create,
+  };
 })();

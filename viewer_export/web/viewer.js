@@ -29,38 +29,9 @@
     return;
   }
 
-  // --- The mesh binary (viewer_export/include/featsense/viewer_export/viewer_mesh_binary.hpp)
-  const MAGIC = 'FSVIEW1';
-  const HEADER_BYTES = 32;
-
+  // --- The mesh binary, mesh.bin
   function parseMesh(buffer, layerNames) {
-    if (buffer.byteLength < HEADER_BYTES) throw new Error('mesh.bin is too short');
-    const magic = String.fromCharCode.apply(null, new Uint8Array(buffer, 0, 7));
-    if (magic !== MAGIC) throw new Error('mesh.bin is not a featsense viewer mesh');
-    const header = new DataView(buffer, 0, HEADER_BYTES);
-    const n = header.getUint32(8, true);
-    const m = header.getUint32(12, true);
-    const k = header.getUint32(16, true);
-    const normalBytes = Math.ceil((3 * n) / 4) * 4;
-    const expected = HEADER_BYTES + n * (3 + k) * 4 + normalBytes + m * 12;
-    if (buffer.byteLength !== expected)
-      throw new Error('mesh.bin holds ' + buffer.byteLength + ' bytes, expected ' + expected);
-    let offset = HEADER_BYTES;
-    const take = function (Type, count, bytes) {
-      const array = new Type(buffer, offset, count);
-      offset += bytes || count * 4;
-      return array;
-    };
-    const mesh = {
-      vertexCount: n,
-      triangleCount: m,
-      positions: take(Float32Array, 3 * n),
-      normals: take(Int8Array, 3 * n, normalBytes),  // times 127
-      indices: take(Uint32Array, 3 * m),
-      layers: {},
-    };
-    for (let i = 0; i < k; ++i) mesh.layers[layerNames[i]] = take(Float32Array, n);
-    return mesh;
+    return featsenseMapScene.parseViewerMesh(buffer, 0, buffer.byteLength, layerNames, 'mesh.bin', false);
   }
 
   // --- Colour maps: each turns a vertex into r, g, b in 0..255.
