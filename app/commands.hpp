@@ -5,11 +5,25 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "cli_context.hpp"
 
 namespace featsense::app {
+
+/// A command that ran but did not do what was asked (e.g. a sensor never found in a map): its
+/// message, and an exit status of its own that scripts can tell from an error (1).
+class CommandFailed : public std::runtime_error {
+ public:
+  CommandFailed(const std::string& message, int exit_code)
+      : std::runtime_error(message), exit_code_(exit_code) {}
+  int exit_code() const { return exit_code_; }
+
+ private:
+  int exit_code_;
+};
 
 struct Command {
   CLI::App* parser;
@@ -48,6 +62,8 @@ Command register_navmesh(CLI::App& app, const CliContext& context);
 Command register_live(CLI::App& app, const CliContext& context);
 /// `featsense replay REC.pcap [--to ADDR] [--rate R] ...`: a recording sent as the sensor did.
 Command register_replay(CLI::App& app, const CliContext& context);
+/// `featsense localize MAP.h5 INPUT -o OUT`: poses in a saved map, the map read only.
+Command register_localize(CLI::App& app, const CliContext& context);
 /// `featsense view OUT [--port N]`: the output folder in the browser, until Ctrl+C.
 Command register_view(CLI::App& app, const CliContext& context);
 

@@ -56,7 +56,8 @@ int main(int argc, char** argv) {
                                                    featsense::app::register_report(app, context),
                                                    featsense::app::register_view(app, context),
                                                    featsense::app::register_replay(app, context),
-                                                   featsense::app::register_live(app, context)};
+                                                   featsense::app::register_live(app, context),
+                                                   featsense::app::register_localize(app, context)};
   for (auto& command : featsense::app::register_eval(app, context)) commands.push_back(command);
   for (auto& command : featsense::app::register_bench(app, context)) commands.push_back(command);
   commands.push_back(featsense::app::register_bench_store(*app.get_subcommand("bench"), context));
@@ -92,6 +93,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const featsense::config::ConfigError& e) {
     return fail(std::string("config: ") + e.what(), 2);
+  } catch (const featsense::app::CommandFailed& e) {
+    return fail(e.what(), e.exit_code());
   } catch (const featsense::app::Interrupted& e) {
     return fail(e.what(), 130);
   } catch (const featsense::slam::InputError& e) {

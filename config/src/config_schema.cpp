@@ -323,6 +323,19 @@ std::vector<KeySpec> make_specs() {
                   1000000),
       integer_key("relocalize.confirmations", &Config::relocalize, &RelocalizeConfig::confirmations,
                   1, 100),
+      number_key("localize.radius", &Config::localize, &LocalizeConfig::radius_m, {5.0, 1000.0}),
+      number_key("localize.cache_mb", &Config::localize, &LocalizeConfig::cache_mb, {16.0, 1e6}),
+      number_key("localize.voxel", &Config::localize, &LocalizeConfig::voxel_m, {0.05, 5.0}),
+      number_key("localize.min_inliers", &Config::localize, &LocalizeConfig::min_inlier_fraction,
+                 {0.0, 1.0}),
+      number_key("localize.max_fitness", &Config::localize, &LocalizeConfig::max_fitness_m,
+                 {0.0, 10.0, true}),
+      number_key("localize.contradiction_inliers", &Config::localize,
+                 &LocalizeConfig::contradiction_fraction, {0.0, 1.0}),
+      integer_key("localize.contradictions", &Config::localize, &LocalizeConfig::contradictions, 1,
+                  1000),
+      number_key("localize.odometry_timeout", &Config::localize,
+                 &LocalizeConfig::odometry_timeout_s, {0.0, 3600.0}),
   };
 }
 
@@ -370,6 +383,12 @@ void validate_relations(const Config& c) {
     throw ConfigError(
         "features.surface_threshold < features.edge_threshold < features.max_edge_threshold "
         "must hold");
+  }
+  if (c.localize.contradiction_fraction >= c.localize.min_inlier_fraction) {
+    throw ConfigError("localize.contradiction_inliers (" +
+                      std::to_string(c.localize.contradiction_fraction) +
+                      ") must be below localize.min_inliers (" +
+                      std::to_string(c.localize.min_inlier_fraction) + ")");
   }
   const double half_smallest = 0.5 * std::min(c.map.size_m[0], c.map.size_m[1]);
   if (c.map.shift_threshold_m > half_smallest) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "featsense/slam/trajectory/rigid_pose.hpp"
@@ -292,6 +293,9 @@ std::vector<VoxelGaussians> levels_of(const GaussianCloud& cloud, const VgicpSet
 
 VgicpTarget::VgicpTarget(const GaussianCloud& cloud, const VgicpSettings& settings)
     : levels(levels_of(cloud, settings)), fitness(cloud, settings.fitness_voxel_m) {}
+
+VgicpTarget::VgicpTarget(std::vector<VoxelGaussians> levels_in, VoxelGaussians fitness_in)
+    : levels(std::move(levels_in)), fitness(std::move(fitness_in)) {}
 
 VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
                   const Eigen::Isometry3d& guess, const VgicpSettings& settings) {

@@ -128,6 +128,19 @@ struct RelocalizeConfig {
   int confirmations = 2;
 };
 
+/// `featsense localize`: scans registered to a saved map's surface (the keys' reasons in
+/// default.yaml).
+struct LocalizeConfig {
+  double radius_m = 60.0;
+  double cache_mb = 512.0;
+  double voxel_m = 0.5;
+  double min_inlier_fraction = 0.5;
+  double max_fitness_m = 0.1;
+  double contradiction_fraction = 0.2;
+  int contradictions = 3;
+  double odometry_timeout_s = 10.0;
+};
+
 struct Config {
   SensorConfig sensor;
   MapConfig map;
@@ -136,6 +149,7 @@ struct Config {
   RefineConfig refine;
   LoopConfig loop;
   RelocalizeConfig relocalize;
+  LocalizeConfig localize;
   /// The keys given a value explicitly (by the YAML file, a --set or a command-line option
   /// that stands for the key), each with where the value that counts came from: "my.yaml:12",
   /// "--set map.voxel_size=0.05", "--voxel 0.05". A key is here even when the value given

@@ -83,6 +83,9 @@ VgicpResult align(const GaussianCloud& target, const GaussianCloud& source,
 /// once for a target that many sources are registered to.
 struct VgicpTarget {
   VgicpTarget(const GaussianCloud& cloud, const VgicpSettings& settings);
+  /// From voxels made beforehand: `levels` coarse to fine as settings.voxel_sizes_m, and the
+  /// fitness voxels.
+  VgicpTarget(std::vector<VoxelGaussians> levels, VoxelGaussians fitness);
   std::vector<VoxelGaussians> levels;  ///< coarse to fine
   VoxelGaussians fitness;
 };

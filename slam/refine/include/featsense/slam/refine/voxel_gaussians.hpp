@@ -26,6 +26,10 @@ class VoxelGaussians {
  public:
   /// `voxel_m` > 0: the voxel edge, metres.
   VoxelGaussians(const GaussianCloud& cloud, double voxel_m);
+  /// From parts summed beforehand (each: the mean of its points, the mean of their
+  /// covariances, how many), e.g. the cells of a finer grid: each part goes to the voxel of
+  /// its mean, weighted by its points, so that the voxels are those of its points.
+  VoxelGaussians(const std::vector<VoxelGaussian>& parts, double voxel_m);
 
   /// The voxel holding `p`, if it holds points (nothing else: a neighbour's mean would pull
   /// the point towards a surface it does not lie on).
@@ -35,6 +39,8 @@ class VoxelGaussians {
   double voxel_m() const { return voxel_m_; }
 
  private:
+  void finish();
+
   double voxel_m_;
   std::unordered_map<uint64_t, VoxelGaussian> voxels_;
 };

@@ -1,0 +1,150 @@
+// featsense localize MAP.h5 INPUT -o OUT: each scan's pose in a saved map, the map read only.
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "commands.hpp"
+#include "featsense/mapping/localizer.hpp"
+#include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "json_output.hpp"
+#include "localize_report.hpp"
+#include "map_options.hpp"
+#include "progress.hpp"
+#include "source_options.hpp"
+#include "stop_signal.hpp"
+
+namespace featsense::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct LocalizeOptions {
+  std::string map;
+  InputOptions input;
+  std::string output;
+  std::optional<std::string> initial_pose;
+  std::optional<std::string> gt;
+  std::optional<uint64_t> start;
+  std::optional<uint64_t> end;
+};
+
+/// A run that never found the sensor in the map: its own exit status, after the report.
+constexpr int kNeverLocalizedExit = 3;
+
+std::string progress_text(const mapping::LocalizerCounts& counts) {
+  const auto count = [&](const char* status) {
+    const auto it = counts.by_status.find(status);
+    return it == counts.by_status.end() ? size_t{0} : it->second;
+  };
+  return std::to_string(count("localized")) + " localized, " + std::to_string(count("odometry")) +
+         " on odometry, " + std::to_string(count("lost")) + " lost";
+}
+
+void log_summary(const LocalizeRun& run) {
+  const mapping::LocalizerCounts& c = run.counts;
+  if (!c.first_fix) return;
+  const double seconds_in =
+      1e-9 * static_cast<double>(c.first_fix->stamp_ns - run.scans.front().stamp_ns);
+  spdlog::info("found after {:.1f} s of the recording ({} scans); {}", seconds_in,
+               c.first_fix->scan, progress_text(c));
+}
+
+void run_localize(const LocalizeOptions& options, const CliContext& context) {
+  const config::Config config = context.load_config();
+  std::optional<Eigen::Isometry3d> initial_pose;
+  if (options.initial_pose) initial_pose = parse_initial_pose(*options.initial_pose);
+  std::optional<slam::Trajectory> truth;
+  if (options.gt) truth = slam::read_trajectory(*options.gt, "auto", {});
+  fs::create_directories(options.output);
+  mapping::Localizer localizer(options.map, config, initial_pose);
+  std::unique_ptr<slam::ScanSource> source = options.input.open(config);
+  const mapping::LocalizerCounts opened = localizer.counts();
+  spdlog::info("localizing {} ({}) in {} ({} keyframes, {} chunks){}", source->info().path,
+               source->info().format, options.map, opened.map_keyframes, opened.map_chunks,
+               initial_pose ? ", from the given initial pose" : "");
+
+  const StopSignal stop_signal("finishing the scan in hand and writing the poses");
+  Progress progress("scans", source->info().frames, context.quiet);
+  LocalizeRun run;
+  run.map = options.map;
+  run.input = source->info();
+  const auto start = std::chrono::steady_clock::now();
+  while (!stop_signal.requested()) {
+    std::optional<slam::Scan> scan = source->next();
+    if (!scan) break;
+    if (options.start && scan->sequence < *options.start) continue;
+    if (options.end && scan->sequence > *options.end) break;
+    run.scans.push_back(localizer.add_scan(*scan));
+    const mapping::LocalizedScan& done = run.scans.back();
+    if (!done.event.empty()) {
+      progress.finish();
+      spdlog::info("scan {}: {}", done.sequence, done.event);
+    }
+    progress.update(run.scans.size(), progress_text(localizer.counts()));
+  }
+  progress.finish();
+  run.interrupted = stop_signal.requested();
+  run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.counts = localizer.counts();
+  run.frames_skipped = source->stats().frames_skipped;
+  run.warnings = source->stats().warning_count;
+  run.input = source->info();
+
+  const fs::path folder(options.output);
+  write_localization_files(run, folder);
+  write_json(localize_report_json(config, run, truth), (folder / "report.json").string());
+  log_summary(run);
+  if (!context.quiet) {
+    std::printf("%s: %zu scans, %s; trajectory.tum, localization.csv, report.json in %s\n",
+                run.counts.first_fix ? "localized" : "not localized", run.scans.size(),
+                progress_text(run.counts).c_str(), folder.string().c_str());
+  }
+  if (run.interrupted) throw Interrupted("localization stopped; what was done is written");
+  if (!run.counts.first_fix) {
+    throw CommandFailed(
+        run.input.path + " was never found in " + options.map + ": none of its " +
+            std::to_string(run.scans.size()) + " scans matched the map (" +
+            std::to_string(run.counts.unconfirmed_matches) +
+            " keyframe matches that the map's surface did not confirm). The recording may show "
+            "another place, or start where the map has not been (--initial-pose "
+            "x,y,z,yaw_deg helps where that is known). No pose was given",
+        kNeverLocalizedExit);
+  }
+}
+
+}  // namespace
+
+Command register_localize(CLI::App& app, const CliContext& context) {
+  auto options = std::make_shared<LocalizeOptions>();
+  CLI::App* command = app.add_subcommand(
+      "localize",
+      "Each scan's pose in a saved map (found from anywhere by the map's keyframes, then "
+      "tracked on its surface); the map is only read. Exit status 3: never found");
+  command->add_option("MAP", options->map, "A map.h5 made by `featsense map`")
+      ->required()
+      ->check(CLI::ExistingFile);
+  options->input.add_to(*command, false);
+  command
+      ->add_option("-o,--output", options->output,
+                   "Folder for trajectory.tum, localization.csv and report.json")
+      ->required();
+  command->add_option("--initial-pose", options->initial_pose,
+                      "x,y,z,yaw_deg: where the first scan is believed to be in the map; "
+                      "verified like any other match");
+  command
+      ->add_option("--gt", options->gt,
+                   "True poses in the map's frame (TUM or KITTI): each pose's error goes "
+                   "into report.json")
+      ->check(CLI::ExistingFile);
+  command->add_option("--start", options->start, "First scan to localize (index)");
+  command->add_option("--end", options->end, "Last scan to localize (index)");
+  return {command, [options, &context] { run_localize(*options, context); }};
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,152 @@
+#pragma once
+/// Localization in a saved map: each scan's pose in the map's frame, the map left as it was.
+///
+/// The states, scan by scan:
+///  - lost: nowhere yet (the start, or after the map was lost). The odometry runs in a frame
+///    of its own and its keyframes are matched against the map's stored keyframes
+///    (`slam::loops::Relocalizer`: place descriptors, verification by registration, several
+///    keyframes that agree). A match is then checked once more against the map's surface;
+///    until it passes, no pose is given.
+///  - localized: the scan registered to the map's surface around the predicted pose
+///    (voxelized GICP, the surface of the TSDF as the target: map_targets) and it fits: enough
+///    of its points lie on the map's surface, closely enough. The prediction is constant
+///    velocity from the last two poses (and deskews the scan), or the odometry's motion while
+///    that still runs.
+///  - odometry: the scan did not fit well enough (changed surroundings, a place the map never
+///    saw, a view blocked): the odometry, started at the last pose, carries the pose on and
+///    the registration is tried again from it each scan. Too long on odometry, or several
+///    scans in a row that contradict the map (almost none of their points on it), and the
+///    sensor is lost.
+/// Why the TSDF's surface as the target, not the keyframes' clouds: it is the map the robot
+/// navigates on (the navigation mesh is made from it), every surface averaged over every scan
+/// that saw it rather than a few thinned scans, complete between keyframes, and read from the
+/// store region by region (a bounded cache, never the whole map).
+/// Not thread-safe: one caller, scans in order.
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "featsense/config/config.hpp"
+#include "featsense/slam/refine/vgicp.hpp"
+#include "featsense/slam/scan.hpp"
+
+namespace featsense::mapping {
+
+enum class LocalizeStatus { kLost, kLocalized, kOdometry };
+/// "lost", "localized", "odometry": the words of the status file and the report.
+const char* to_string(LocalizeStatus status);
+
+/// localize.* of the configuration, and what has no key.
+struct LocalizerSettings {
+  double radius_m = config::LocalizeConfig{}.radius_m;
+  size_t cache_bytes = static_cast<size_t>(config::LocalizeConfig{}.cache_mb * 1024 * 1024);
+  double voxel_m = config::LocalizeConfig{}.voxel_m;
+  double min_inlier_fraction = config::LocalizeConfig{}.min_inlier_fraction;
+  double max_fitness_m = config::LocalizeConfig{}.max_fitness_m;
+  double contradiction_fraction = config::LocalizeConfig{}.contradiction_fraction;
+  size_t contradictions = static_cast<size_t>(config::LocalizeConfig{}.contradictions);
+  double odometry_timeout_s = config::LocalizeConfig{}.odometry_timeout_s;
+  /// The registration to the map: from a prediction a few centimetres off, so a few coarse
+  /// iterations and fine voxels (the finest is the cell the map's surface is summed in).
+  slam::refine::VgicpSettings vgicp = tracking_vgicp();
+  /// A fit needs this many of the scan's points where the map observed anything.
+  size_t min_observed_points = 50;
+  /// Covariances of a scan's points from this many nearest.
+  int neighbours = 10;
+  /// Voxels of the map's surface observed at least this much (as its mesh's).
+  double min_weight = 0.5;
+  /// Fits in a row after which the odometry stops and constant velocity predicts.
+  size_t settle_scans = 5;
+
+  static slam::refine::VgicpSettings tracking_vgicp();
+};
+
+LocalizerSettings localizer_from_config(const config::Config& config);
+
+/// One scan's answer.
+struct LocalizedScan {
+  uint64_t sequence = 0;
+  int64_t stamp_ns = 0;
+  LocalizeStatus status = LocalizeStatus::kLost;
+  /// The sensor's pose in the map at the stamp; none while lost.
+  std::optional<Eigen::Isometry3d> T_map_sensor;
+  /// The registration to the map, where one was made: its fit at the result.
+  bool registered = false;
+  double fitness_m = 0.0;
+  /// Of its points where the map observed anything, the share on the map's surface.
+  double inlier_fraction = 0.0;
+  double coverage = 0.0;  ///< the share of its points where the map observed anything
+  int iterations = 0;
+  double ms = 0.0;  ///< add_scan's time
+  /// What changed at this scan, for the log ("localized: ...", "lost: ..."); mostly empty.
+  std::string event;
+};
+
+/// Where the sensor was first found, and how.
+struct LocalizationFix {
+  size_t scan = 0;  ///< scans given before it
+  int64_t stamp_ns = 0;
+  std::string found_by;  ///< "descriptor", "guess" or "earlier match"
+  double descriptor_distance = 1.0;
+  double fitness_m = 0.0;  ///< the check against the map's surface
+  double inlier_fraction = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+};
+
+struct LocalizerCounts {
+  size_t scans = 0;
+  std::map<std::string, size_t> by_status;  ///< to_string(status) -> scans
+  size_t fixes = 0;                         ///< times found (the first and after each loss)
+  std::map<std::string, size_t> losses;     ///< by reason
+  size_t unconfirmed_matches = 0;           ///< keyframe matches the map's surface did not confirm
+  std::optional<LocalizationFix> first_fix;
+  std::vector<double> tracking_ms;  ///< per scan registered while localized or on odometry
+  std::vector<double> search_ms;    ///< per scan while lost
+  size_t map_keyframes = 0;
+  size_t map_chunks = 0;
+  /// The map's surface: chunks read, reused, the cache's bytes.
+  size_t chunks_made = 0;
+  size_t chunks_reused = 0;
+  size_t chunks_evicted = 0;
+  size_t peak_cache_bytes = 0;
+  double chunk_read_ms = 0.0;
+  double chunk_cells_ms = 0.0;
+  /// The targets made around the sensor, and the time tracking waited for them.
+  size_t targets_built = 0;
+  size_t targets_waited = 0;
+  double target_build_ms = 0.0;
+  double target_wait_ms = 0.0;
+};
+
+class Localizer {
+ public:
+  /// Opens `map` (a featsense map.h5) read-only and reads its keyframes. `initial_pose` (the
+  /// first scan's pose in the map, a user's guess) narrows the first search; it is verified
+  /// like every match. Throws std::runtime_error naming the file and the problem (missing,
+  /// corrupt, no keyframes), config::ConfigError where the configuration sets another voxel
+  /// size than the map's.
+  Localizer(const std::filesystem::path& map, const config::Config& config,
+            const std::optional<Eigen::Isometry3d>& initial_pose = std::nullopt);
+  ~Localizer();
+  Localizer(const Localizer&) = delete;
+  Localizer& operator=(const Localizer&) = delete;
+
+  LocalizedScan add_scan(const slam::Scan& scan);
+
+  LocalizerCounts counts() const;
+  const LocalizerSettings& settings() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace featsense::mapping

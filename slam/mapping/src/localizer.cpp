@@ -1,0 +1,408 @@
+#include "featsense/mapping/localizer.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+#include "featsense/config/config_error.hpp"
+#include "featsense/mapping/saved_map.hpp"
+#include "featsense/slam/loops/loop_closer.hpp"
+#include "featsense/slam/loops/relocalizer.hpp"
+#include "featsense/slam/odometry/odometry_locator.hpp"
+#include "featsense/slam/refine/refinement_cloud.hpp"
+#include "featsense/slam/trajectory/pose_interpolation.hpp"
+#include "featsense/slam/trajectory/sweep_motion.hpp"
+#include "map_surface.hpp"
+#include "map_targets.hpp"
+
+namespace featsense::mapping {
+
+const char* to_string(LocalizeStatus status) {
+  switch (status) {
+    case LocalizeStatus::kLost:
+      return "lost";
+    case LocalizeStatus::kLocalized:
+      return "localized";
+    case LocalizeStatus::kOdometry:
+      return "odometry";
+  }
+  return "lost";
+}
+
+slam::refine::VgicpSettings LocalizerSettings::tracking_vgicp() {
+  slam::refine::VgicpSettings settings;
+  settings.voxel_sizes_m = {1.0, 0.5, 0.25};
+  settings.max_iterations = 10;
+  settings.step_tolerance_m = 5e-4;
+  // A point of a thinned scan (one per half-metre voxel: a centroid, not a surface sample)
+  // lies within a few centimetres of a plane, more on poles, trees and cars.
+  settings.inlier_distance_m = 0.2;
+  settings.fitness_voxel_m = 0.5;
+  return settings;
+}
+
+LocalizerSettings localizer_from_config(const config::Config& config) {
+  const config::LocalizeConfig& c = config.localize;
+  LocalizerSettings s;
+  s.radius_m = c.radius_m;
+  s.cache_bytes = static_cast<size_t>(c.cache_mb * 1024.0 * 1024.0);
+  s.voxel_m = c.voxel_m;
+  s.min_inlier_fraction = c.min_inlier_fraction;
+  s.max_fitness_m = c.max_fitness_m;
+  s.contradiction_fraction = c.contradiction_fraction;
+  s.contradictions = static_cast<size_t>(c.contradictions);
+  s.odometry_timeout_s = c.odometry_timeout_s;
+  return s;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// A scan's place from its stamp's pose and the motion over it (constant velocity from the
+/// previous pose), in the form the scan's cloud is deskewed by.
+slam::ScanPlacement predicted_placement(const slam::Scan& scan, const Eigen::Isometry3d& T,
+                                        const slam::SweepMotion& sweep) {
+  slam::ScanPlacement placement;
+  placement.sequence = scan.sequence;
+  placement.stamp_ns = scan.stamp_ns;
+  placement.T_map_sensor = T;
+  placement.column_T_map_sensor = slam::column_poses(
+      scan, T, [&](double t) -> std::optional<Eigen::Isometry3d> { return T * sweep.at(t); });
+  return placement;
+}
+
+std::string metres_text(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f mm", 1000.0 * m);
+  return text;
+}
+
+}  // namespace
+
+struct Localizer::State {
+  State(const std::filesystem::path& map, const config::Config& config_in,
+        const std::optional<Eigen::Isometry3d>& initial)
+      : config(config_in),
+        settings(localizer_from_config(config_in)),
+        saved(read_saved_map(map)),
+        surface(map, settings.cache_bytes, settings.vgicp.voxel_sizes_m.back(),
+                settings.vgicp.fitness_voxel_m, settings.min_weight),
+        targets(surface, settings.radius_m, settings.vgicp, settings.vgicp.fitness_voxel_m),
+        initial_pose(initial) {
+    relocalize = slam::loops::relocalize_from_config(config);
+  }
+
+  struct Pose {
+    int64_t stamp_ns = 0;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  };
+  struct Fit {
+    slam::refine::VgicpResult result;
+    MapFit map;
+    bool good = false;
+    bool contradicts = false;
+    size_t points = 0;
+  };
+
+  /// The search from scratch: the odometry from `T_first` (the belief, or the identity) and a
+  /// relocalizer that tries the map keyframes around the belief too where there is one.
+  void start_search(const std::optional<Eigen::Isometry3d>& belief) {
+    odometry = slam::odometry::make_odometry_locator(
+        config, belief.value_or(Eigen::Isometry3d::Identity()));
+    T_map_odometry = Eigen::Isometry3d::Identity();
+    slam::loops::RelocalizeSettings reloc = relocalize;
+    if (belief) reloc.guess = Eigen::Isometry3d::Identity();
+    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, reloc);
+    selector = std::make_unique<slam::loops::KeyframeSelector>(reloc.loop.keyframe_distance_m,
+                                                               reloc.loop.keyframe_angle_deg);
+    search_belief = belief;
+    last.reset();
+    before_last.reset();
+  }
+
+  Fit register_to_map(const slam::Scan& scan, const slam::ScanPlacement& motion,
+                      const Eigen::Isometry3d& guess) {
+    Fit fit;
+    const slam::refine::GaussianCloud cloud =
+        slam::refine::refinement_cloud(scan, motion, settings.voxel_m, settings.neighbours);
+    fit.points = cloud.size();
+    fit.result.T_target_source = guess;
+    // Too few points to say anything: neither a fit nor a contradiction.
+    constexpr size_t kMinPoints = 30;
+    if (cloud.size() < kMinPoints) return fit;
+    const std::shared_ptr<const MapTarget> target = targets.around(guess.translation());
+    fit.result = slam::refine::align(target->vgicp, cloud, guess, settings.vgicp);
+    fit.map = measure_map_fit(*target, cloud, fit.result.T_target_source,
+                              settings.vgicp.inlier_distance_m);
+    // Where the map saw too little of what the scan sees, the fit says nothing either way.
+    const bool telling = fit.map.observed >= settings.min_observed_points;
+    fit.good = telling && fit.result.converged &&
+               fit.map.inlier_fraction >= settings.min_inlier_fraction &&
+               fit.map.fitness_m <= settings.max_fitness_m;
+    fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
+    return fit;
+  }
+
+  void remember(int64_t stamp_ns, const Eigen::Isometry3d& T) {
+    before_last = last;
+    last = Pose{stamp_ns, T};
+  }
+
+  LocalizedScan search(const slam::Scan& scan) {
+    LocalizedScan out;
+    if (!odometry) start_search(initial_pose);
+    std::string why;
+    const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
+    if (!placed || !selector->next(placed->T_map_sensor)) return out;
+    const std::vector<Eigen::Vector3f> points =
+        slam::refine::voxel_centroids(scan, *placed, relocalize.loop.cloud_voxel_m);
+    const std::optional<slam::loops::Relocalization> found = relocalizer->add_keyframe(
+        scan.stamp_ns, placed->T_map_sensor, selector->travelled_m(), points);
+    if (!found) return out;
+    // The session's frame here is the odometry's, which starts at the belief.
+    const Eigen::Isometry3d guess = found->T_map_session * placed->T_map_sensor;
+    const Fit fit = register_to_map(scan, *placed, guess);
+    out.registered = true;
+    out.fitness_m = fit.map.fitness_m;
+    out.inlier_fraction = fit.map.inlier_fraction;
+    out.coverage = fit.map.coverage;
+    out.iterations = fit.result.iterations;
+    if (!fit.good) {
+      ++counts.unconfirmed_matches;
+      out.event = "a match with the map's keyframes that its surface does not confirm (" +
+                  std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +
+                  " % of the scan on it): searching on";
+      // The relocalizer keeps a placement once made; a fresh one searches on, with the same
+      // odometry.
+      slam::loops::RelocalizeSettings reloc = relocalize;
+      if (search_belief) reloc.guess = Eigen::Isometry3d::Identity();
+      relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, reloc);
+      return out;
+    }
+    const Eigen::Isometry3d T = fit.result.T_target_source;
+    status = LocalizeStatus::kLocalized;
+    T_map_odometry = T * placed->T_map_sensor.inverse();
+    good_in_row = 1;
+    contradicted_in_row = 0;
+    on_odometry_since.reset();
+    remember(scan.stamp_ns, T);
+    out.status = status;
+    out.T_map_sensor = T;
+    ++counts.fixes;
+    LocalizationFix fix;
+    fix.scan = counts.scans;
+    fix.stamp_ns = scan.stamp_ns;
+    fix.found_by = found->found_by;
+    fix.descriptor_distance = found->descriptor_distance;
+    fix.fitness_m = fit.map.fitness_m;
+    fix.inlier_fraction = fit.map.inlier_fraction;
+    fix.position = T.translation();
+    if (!counts.first_fix) counts.first_fix = fix;
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "localized at (%.1f, %.1f, %.1f) by %s: %d %% of the scan on the map's "
+                  "surface, fitness %s",
+                  fix.position.x(), fix.position.y(), fix.position.z(), fix.found_by.c_str(),
+                  static_cast<int>(100.0 * fix.inlier_fraction),
+                  metres_text(fix.fitness_m).c_str());
+    out.event = text;
+    return out;
+  }
+
+  LocalizedScan lose(const slam::Scan& scan, const std::string& reason,
+                     const Eigen::Isometry3d& belief) {
+    LocalizedScan out;
+    ++counts.losses[reason];
+    out.event = "lost: " + reason;
+    status = LocalizeStatus::kLost;
+    on_odometry_since.reset();
+    start_search(belief);
+    // The scan that lost it is the first of the search.
+    std::string why;
+    const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
+    if (placed) selector->next(placed->T_map_sensor);
+    return out;
+  }
+
+  LocalizedScan track(const slam::Scan& scan) {
+    // The prediction: the odometry's motion while it runs, else constant velocity.
+    std::optional<slam::ScanPlacement> motion;
+    Eigen::Isometry3d predicted = last->T;
+    if (odometry) {
+      std::string why;
+      motion = odometry->locate(scan, why);
+      if (motion) predicted = T_map_odometry * motion->T_map_sensor;
+    }
+    if (!motion) {
+      slam::SweepMotion sweep;
+      if (before_last) {
+        const double period_s = 1e-9 * static_cast<double>(last->stamp_ns - before_last->stamp_ns);
+        const double elapsed_s = 1e-9 * static_cast<double>(scan.stamp_ns - last->stamp_ns);
+        const Eigen::Isometry3d step = before_last->T.inverse() * last->T;
+        if (period_s > 0.0 && elapsed_s > 0.0) {
+          const Eigen::Isometry3d ahead = slam::motion_fraction(step, elapsed_s / period_s);
+          predicted = last->T * ahead;
+          sweep = slam::SweepMotion(ahead, elapsed_s);
+        }
+      }
+      motion = predicted_placement(scan, predicted, sweep);
+    }
+    const Fit fit = register_to_map(scan, *motion, predicted);
+    LocalizedScan out;
+    out.registered = fit.points > 0;
+    out.fitness_m = fit.map.fitness_m;
+    out.inlier_fraction = fit.map.inlier_fraction;
+    out.coverage = fit.map.coverage;
+    out.iterations = fit.result.iterations;
+    if (fit.good) {
+      const Eigen::Isometry3d T = fit.result.T_target_source;
+      if (status == LocalizeStatus::kOdometry) out.event = "localized again";
+      status = LocalizeStatus::kLocalized;
+      contradicted_in_row = 0;
+      on_odometry_since.reset();
+      if (odometry) {
+        T_map_odometry = T * motion->T_map_sensor.inverse();
+        if (++good_in_row >= settings.settle_scans) odometry.reset();
+      }
+      remember(scan.stamp_ns, T);
+      out.status = status;
+      out.T_map_sensor = T;
+      return out;
+    }
+    good_in_row = 0;
+    contradicted_in_row = fit.contradicts ? contradicted_in_row + 1 : 0;
+    if (contradicted_in_row >= settings.contradictions) {
+      return lose(scan,
+                  std::to_string(contradicted_in_row) +
+                      " scans in a row with almost none of their points on the map",
+                  predicted);
+    }
+    if (!on_odometry_since) on_odometry_since = scan.stamp_ns;
+    if (1e-9 * static_cast<double>(scan.stamp_ns - *on_odometry_since) >
+        settings.odometry_timeout_s) {
+      return lose(scan, "no fit to the map for longer than localize.odometry_timeout", predicted);
+    }
+    if (status == LocalizeStatus::kLocalized) {
+      out.event =
+          "on odometry: " + std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +
+          " % of the scan on the map";
+    }
+    status = LocalizeStatus::kOdometry;
+    if (!odometry) {
+      // Started here: its first scan is this one, at the pose predicted for it.
+      odometry = slam::odometry::make_odometry_locator(config, predicted);
+      T_map_odometry = Eigen::Isometry3d::Identity();
+      std::string why;
+      odometry->locate(scan, why);
+    }
+    remember(scan.stamp_ns, predicted);
+    out.status = status;
+    out.T_map_sensor = predicted;
+    return out;
+  }
+
+  config::Config config;
+  LocalizerSettings settings;
+  SavedMap saved;
+  MapSurface surface;
+  MapTargets targets;
+  std::optional<Eigen::Isometry3d> initial_pose;
+  slam::loops::RelocalizeSettings relocalize;
+
+  LocalizeStatus status = LocalizeStatus::kLost;
+  std::unique_ptr<slam::odometry::OdometryLocator> odometry;
+  Eigen::Isometry3d T_map_odometry = Eigen::Isometry3d::Identity();
+  std::unique_ptr<slam::loops::Relocalizer> relocalizer;
+  std::unique_ptr<slam::loops::KeyframeSelector> selector;
+  std::optional<Eigen::Isometry3d> search_belief;
+  std::optional<Pose> last;
+  std::optional<Pose> before_last;
+  size_t good_in_row = 0;
+  size_t contradicted_in_row = 0;
+  std::optional<int64_t> on_odometry_since;
+  LocalizerCounts counts;
+};
+
+namespace {
+
+/// The checks a map must pass before anything is read from it besides its header.
+void check_map_request(const std::filesystem::path& map) {
+  if (map.extension() == ".vdb") {
+    throw std::runtime_error(map.string() +
+                             ": a .vdb keeps no keyframes to find the sensor by; localize in "
+                             "the map.h5 it was exported from");
+  }
+  if (!std::filesystem::exists(map)) throw std::runtime_error("no such map: " + map.string());
+}
+
+}  // namespace
+
+Localizer::Localizer(const std::filesystem::path& map, const config::Config& config,
+                     const std::optional<Eigen::Isometry3d>& initial_pose) {
+  check_map_request(map);
+  state_ = std::make_unique<State>(map, config, initial_pose);
+  const storage::MapMetadata& metadata = state_->surface.metadata();
+  if (config.is_explicit("map.voxel_size") &&
+      std::abs(config.map.voxel_size_m - metadata.voxel_size_m) > 1e-9) {
+    throw config::ConfigError(
+        map.string() + " has voxels of " + std::to_string(metadata.voxel_size_m) +
+        " m, but map.voxel_size is set to " + std::to_string(config.map.voxel_size_m) + " m (" +
+        config.explicit_keys.at("map.voxel_size") +
+        "): a map is localized in at its own voxel size; leave map.voxel_size unset");
+  }
+  if (state_->saved.keyframes.empty()) {
+    throw std::runtime_error(
+        map.string() +
+        " keeps no keyframes (it was made with given poses, with loop closure off or by an "
+        "older featsense): the sensor is found in a map by its keyframes; map the place "
+        "again without --gt");
+  }
+  if (state_->surface.chunks() == 0)
+    throw std::runtime_error(map.string() + " holds no surface: its map is empty");
+  state_->counts.map_keyframes = state_->saved.keyframes.size();
+  state_->counts.map_chunks = state_->surface.chunks();
+}
+
+Localizer::~Localizer() = default;
+
+LocalizedScan Localizer::add_scan(const slam::Scan& scan) {
+  State& s = *state_;
+  const auto start = Clock::now();
+  const bool tracking = s.status != LocalizeStatus::kLost;
+  LocalizedScan out = tracking ? s.track(scan) : s.search(scan);
+  out.sequence = scan.sequence;
+  out.stamp_ns = scan.stamp_ns;
+  out.ms = ms_since(start);
+  ++s.counts.scans;
+  ++s.counts.by_status[to_string(out.status)];
+  (tracking ? s.counts.tracking_ms : s.counts.search_ms).push_back(out.ms);
+  return out;
+}
+
+LocalizerCounts Localizer::counts() const {
+  LocalizerCounts out = state_->counts;
+  const MapSurfaceCounts surface = state_->surface.counts();
+  out.chunks_made = surface.chunks_made;
+  out.chunks_reused = surface.chunks_reused;
+  out.chunks_evicted = surface.chunks_evicted;
+  out.peak_cache_bytes = surface.peak_cached_bytes;
+  out.chunk_read_ms = surface.read_ms;
+  out.chunk_cells_ms = surface.cells_ms;
+  const MapTargetCounts targets = state_->targets.counts();
+  out.targets_built = targets.built;
+  out.targets_waited = targets.waited;
+  out.target_build_ms = targets.build_ms;
+  out.target_wait_ms = targets.wait_ms;
+  return out;
+}
+
+const LocalizerSettings& Localizer::settings() const { return state_->settings; }
+
+}  // namespace featsense::mapping

@@ -1,0 +1,154 @@
+#include "map_targets.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "background_thread.hpp"
+
+namespace featsense::mapping {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
+                       const Eigen::Isometry3d& T, double inlier_distance_m) {
+  MapFit fit;
+  fit.points = cloud.size();
+  double squares = 0.0;
+  std::vector<const slam::refine::VoxelGaussian*> found;
+  for (const Eigen::Vector3d& p : cloud.points) {
+    const Eigen::Vector3d q = T * p;
+    const std::array<int32_t, 3> block = {static_cast<int32_t>(std::floor(q.x() / target.block_m)),
+                                          static_cast<int32_t>(std::floor(q.y() / target.block_m)),
+                                          static_cast<int32_t>(std::floor(q.z() / target.block_m))};
+    if (target.observed.count(grid_key(block)) == 0) continue;
+    ++fit.observed;
+    target.vgicp.fitness.near(q, found);
+    if (found.empty()) continue;
+    const double d = found.front()->normal.dot(q - found.front()->mean);
+    if (std::abs(d) > inlier_distance_m) continue;
+    ++fit.inliers;
+    squares += d * d;
+  }
+  if (fit.observed > 0)
+    fit.inlier_fraction = static_cast<double>(fit.inliers) / static_cast<double>(fit.observed);
+  if (fit.points > 0)
+    fit.coverage = static_cast<double>(fit.observed) / static_cast<double>(fit.points);
+  if (fit.inliers > 0) fit.fitness_m = std::sqrt(squares / static_cast<double>(fit.inliers));
+  return fit;
+}
+
+MapTargets::MapTargets(MapSurface& surface, double radius_m,
+                       const slam::refine::VgicpSettings& vgicp, double block_m)
+    : surface_(surface), radius_m_(radius_m), vgicp_(vgicp), block_m_(block_m) {
+  if (vgicp_.voxel_sizes_m.empty())
+    throw std::invalid_argument("MapTargets: the registration needs at least one voxel size");
+  thread_ = std::thread([this] { run(); });
+}
+
+MapTargets::~MapTargets() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre) {
+  const auto start = std::chrono::steady_clock::now();
+  const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m_);
+  const std::vector<std::shared_ptr<const ChunkSurface>> surfaces =
+      surface_.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
+  std::vector<slam::refine::VoxelGaussian> parts;
+  std::unordered_set<uint64_t> observed;
+  const double radius2 = radius_m_ * radius_m_;
+  for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces) {
+    for (const SurfaceCell& cell : chunk->cells) {
+      if ((cell.mean.cast<double>() - centre).head<2>().squaredNorm() > radius2) continue;
+      parts.push_back(to_voxel_gaussian(cell));
+    }
+    for (const std::array<int32_t, 3>& block : chunk->observed_blocks)
+      observed.insert(grid_key(block));
+  }
+  std::vector<slam::refine::VoxelGaussians> levels;
+  for (const double voxel_m : vgicp_.voxel_sizes_m) levels.emplace_back(parts, voxel_m);
+  slam::refine::VoxelGaussians fitness(parts, vgicp_.fitness_voxel_m);
+  auto made = std::make_shared<MapTarget>(
+      centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
+  made->cells = parts.size();
+  made->observed = std::move(observed);
+  made->block_m = block_m_;
+  std::shared_ptr<const MapTarget> target = std::move(made);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counts_.built;
+  counts_.build_ms += ms_since(start);
+  counts_.last_cells = parts.size();
+  return target;
+}
+
+std::shared_ptr<const MapTarget> MapTargets::around(const Eigen::Vector3d& position) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto near = [&](const std::shared_ptr<const MapTarget>& target, double within) {
+    return target && (target->centre - position).head<2>().norm() <= within;
+  };
+  if (!near(newest_, 0.5 * radius_m_)) {
+    // Far from every target: one made in the background for another place is of no use.
+    const auto start = std::chrono::steady_clock::now();
+    wake_.wait(lock, [&] { return !building_; });
+    if (!near(newest_, 0.5 * radius_m_)) {
+      lock.unlock();
+      std::shared_ptr<const MapTarget> target = build(position);
+      lock.lock();
+      newest_ = std::move(target);
+    }
+    ++counts_.waited;
+    counts_.wait_ms += ms_since(start);
+  }
+  if (!near(newest_, 0.25 * radius_m_) && !building_) {
+    requested_ = position;
+    wake_.notify_all();
+  }
+  return newest_;
+}
+
+void MapTargets::run() {
+  // Below the tracking, which is what the user waits for, and leaving it a core.
+  BackgroundThread background(kBackgroundNice);
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [&] { return stop_ || requested_.has_value(); });
+    if (stop_) return;
+    const Eigen::Vector3d centre = *requested_;
+    requested_.reset();
+    building_ = true;
+    lock.unlock();
+    std::shared_ptr<const MapTarget> target;
+    try {
+      background.run([&] { target = build(centre); });
+    } catch (...) {
+      // The next request (or the tracking's own build) meets the error again, where it can
+      // be reported.
+    }
+    lock.lock();
+    building_ = false;
+    if (target) newest_ = std::move(target);
+    wake_.notify_all();
+  }
+}
+
+MapTargetCounts MapTargets::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counts_;
+}
+
+}  // namespace featsense::mapping

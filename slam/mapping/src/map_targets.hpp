@@ -1,0 +1,95 @@
+#pragma once
+// The part of a saved map's surface that scans are registered to: the voxels of voxelized
+// GICP made from the surface cells (map_surface.hpp) within a radius of the sensor. A target
+// serves while the sensor stays near its centre; once the sensor has moved a quarter of the
+// radius, the next is made on a thread of its own from the cells around the sensor's place
+// then, so that tracking never waits for the file, except where it jumps (the first target,
+// a sensor found somewhere else).
+
+#include <Eigen/Core>
+
+#include <condition_variable>
+#include <cstddef>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <unordered_set>
+#include <utility>
+
+#include "featsense/slam/refine/vgicp.hpp"
+#include "map_surface.hpp"
+
+namespace featsense::mapping {
+
+struct MapTarget {
+  MapTarget(const Eigen::Vector3d& centre_in, slam::refine::VgicpTarget vgicp_in)
+      : centre(centre_in), vgicp(std::move(vgicp_in)) {}
+  Eigen::Vector3d centre;
+  slam::refine::VgicpTarget vgicp;
+  size_t cells = 0;
+  /// grid_key() of the blocks (block_m across) where the map observed anything.
+  std::unordered_set<uint64_t> observed;
+  double block_m = 0.5;
+};
+
+/// How a scan placed at a pose fits the map: of its points where the map observed anything,
+/// the share within `inlier_distance_m` of the surface (the rest contradict the map: free
+/// space there, or a surface elsewhere); and the share of its points the map observed at all
+/// (the rest say nothing: the map never looked there).
+struct MapFit {
+  size_t points = 0;
+  size_t observed = 0;
+  size_t inliers = 0;
+  double inlier_fraction = 0.0;  ///< inliers / observed
+  double coverage = 0.0;         ///< observed / points
+  double fitness_m = 0.0;        ///< RMS distance of the inliers to the surface
+};
+MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
+                       const Eigen::Isometry3d& T, double inlier_distance_m);
+
+struct MapTargetCounts {
+  size_t built = 0;
+  size_t waited = 0;  ///< targets the tracking had to wait for
+  double build_ms = 0.0;
+  double wait_ms = 0.0;
+  size_t last_cells = 0;
+};
+
+class MapTargets {
+ public:
+  /// Targets of `radius_m` around the sensor with the voxels of `vgicp` (its voxel sizes must
+  /// be multiples of the surface's cells, the finest the cell itself).
+  MapTargets(MapSurface& surface, double radius_m, const slam::refine::VgicpSettings& vgicp,
+             double block_m);
+  ~MapTargets();
+  MapTargets(const MapTargets&) = delete;
+  MapTargets& operator=(const MapTargets&) = delete;
+
+  /// A target for a sensor at `position`: the newest whose centre lies within half the radius,
+  /// else one made now. Asks for the next in the background where the sensor has moved a
+  /// quarter of the radius from the newest's centre.
+  std::shared_ptr<const MapTarget> around(const Eigen::Vector3d& position);
+
+  MapTargetCounts counts() const;
+
+ private:
+  std::shared_ptr<const MapTarget> build(const Eigen::Vector3d& centre);
+  void run();
+
+  MapSurface& surface_;
+  double radius_m_;
+  slam::refine::VgicpSettings vgicp_;
+  double block_m_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::shared_ptr<const MapTarget> newest_;
+  std::optional<Eigen::Vector3d> requested_;
+  bool building_ = false;
+  bool stop_ = false;
+  MapTargetCounts counts_;
+  std::thread thread_;
+};
+
+}  // namespace featsense::mapping
