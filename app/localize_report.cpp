@@ -214,10 +214,19 @@ nlohmann::json localize_report_json(const config::Config& config, const Localize
   for (const LocalizedScan& scan : run.scans) latency.push_back(scan.ms);
   double search_total_ms = 0.0;
   for (const double ms : c.search_ms) search_total_ms += ms;
-  report["timings"] = {{"tracking", bench::timing_json(c.tracking_ms)},
-                       {"search", bench::timing_json(c.search_ms)},
-                       {"search_total_s", 1e-3 * search_total_ms},
-                       {"per_scan", bench::timing_json(latency)}};
+  const size_t clouds = c.cloud_ms.size();
+  report["timings"] = {
+      {"tracking", bench::timing_json(c.tracking_ms)},
+      {"tracking_parts",
+       {{"odometry", bench::timing_json(c.odometry_ms)},
+        {"cloud", bench::timing_json(c.cloud_ms)},
+        {"register", bench::timing_json(c.register_ms)},
+        {"points_per_scan",
+         clouds > 0 ? static_cast<double>(c.points_per_scan_sum) / static_cast<double>(clouds)
+                    : 0.0}}},
+      {"search", bench::timing_json(c.search_ms)},
+      {"search_total_s", 1e-3 * search_total_ms},
+      {"per_scan", bench::timing_json(latency)}};
   report["map_cache"] = {{"map_chunks", c.map_chunks},
                          {"map_keyframes", c.map_keyframes},
                          {"chunks_read", c.chunks_made},

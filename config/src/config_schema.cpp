@@ -326,6 +326,8 @@ std::vector<KeySpec> make_specs() {
       number_key("localize.radius", &Config::localize, &LocalizeConfig::radius_m, {5.0, 1000.0}),
       number_key("localize.cache_mb", &Config::localize, &LocalizeConfig::cache_mb, {16.0, 1e6}),
       number_key("localize.voxel", &Config::localize, &LocalizeConfig::voxel_m, {0.05, 5.0}),
+      integer_key("localize.max_points", &Config::localize, &LocalizeConfig::max_points, 100,
+                  1000000),
       number_key("localize.min_inliers", &Config::localize, &LocalizeConfig::min_inlier_fraction,
                  {0.0, 1.0}),
       number_key("localize.max_fitness", &Config::localize, &LocalizeConfig::max_fitness_m,

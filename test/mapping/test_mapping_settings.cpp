@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "featsense/mapping/localizer.hpp"
 #include "featsense/mapping/map_pass.hpp"
 #include "featsense/mapping/recording.hpp"
 
@@ -75,6 +76,43 @@ TEST(MappingSettings, EverySensorKeyReachesTheReader) {
   expected.imu_topic = "/imu";
   expected.imu_rotation_deg = {1.0, 2.0, 3.0};
   expect_same(source_options(config, std::string("meta.json"), std::string("/points")), expected);
+}
+
+TEST(MappingSettings, TheDefaultConfigurationGivesTheDefaultLocalizer) {
+  const LocalizerSettings configured = localizer_from_config(config::Config{});
+  const LocalizerSettings defaults;
+  EXPECT_EQ(configured.radius_m, defaults.radius_m);
+  EXPECT_EQ(configured.cache_bytes, defaults.cache_bytes);
+  EXPECT_EQ(configured.voxel_m, defaults.voxel_m);
+  EXPECT_EQ(configured.max_points, defaults.max_points);
+  EXPECT_EQ(configured.min_inlier_fraction, defaults.min_inlier_fraction);
+  EXPECT_EQ(configured.max_fitness_m, defaults.max_fitness_m);
+  EXPECT_EQ(configured.contradiction_fraction, defaults.contradiction_fraction);
+  EXPECT_EQ(configured.contradictions, defaults.contradictions);
+  EXPECT_EQ(configured.odometry_timeout_s, defaults.odometry_timeout_s);
+}
+
+TEST(MappingSettings, TheLocalizeKeysReachTheirSettings) {
+  config::Config config;
+  config.localize.radius_m = 40.0;
+  config.localize.cache_mb = 64.0;
+  config.localize.voxel_m = 0.3;
+  config.localize.max_points = 5000;
+  config.localize.min_inlier_fraction = 0.6;
+  config.localize.max_fitness_m = 0.05;
+  config.localize.contradiction_fraction = 0.1;
+  config.localize.contradictions = 5;
+  config.localize.odometry_timeout_s = 20.0;
+  const LocalizerSettings s = localizer_from_config(config);
+  EXPECT_EQ(s.radius_m, 40.0);
+  EXPECT_EQ(s.cache_bytes, size_t{64} << 20);
+  EXPECT_EQ(s.voxel_m, 0.3);
+  EXPECT_EQ(s.max_points, 5000u);
+  EXPECT_EQ(s.min_inlier_fraction, 0.6);
+  EXPECT_EQ(s.max_fitness_m, 0.05);
+  EXPECT_EQ(s.contradiction_fraction, 0.1);
+  EXPECT_EQ(s.contradictions, 5u);
+  EXPECT_EQ(s.odometry_timeout_s, 20.0);
 }
 
 }  // namespace

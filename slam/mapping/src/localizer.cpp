@@ -16,6 +16,7 @@
 #include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "map_surface.hpp"
 #include "map_targets.hpp"
+#include "timed_scan_cloud.hpp"
 
 namespace featsense::mapping {
 
@@ -49,6 +50,7 @@ LocalizerSettings localizer_from_config(const config::Config& config) {
   s.radius_m = c.radius_m;
   s.cache_bytes = static_cast<size_t>(c.cache_mb * 1024.0 * 1024.0);
   s.voxel_m = c.voxel_m;
+  s.max_points = static_cast<size_t>(c.max_points);
   s.min_inlier_fraction = c.min_inlier_fraction;
   s.max_fitness_m = c.max_fitness_m;
   s.contradiction_fraction = c.contradiction_fraction;
@@ -63,19 +65,6 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-/// A scan's place from its stamp's pose and the motion over it (constant velocity from the
-/// previous pose), in the form the scan's cloud is deskewed by.
-slam::ScanPlacement predicted_placement(const slam::Scan& scan, const Eigen::Isometry3d& T,
-                                        const slam::SweepMotion& sweep) {
-  slam::ScanPlacement placement;
-  placement.sequence = scan.sequence;
-  placement.stamp_ns = scan.stamp_ns;
-  placement.T_map_sensor = T;
-  placement.column_T_map_sensor = slam::column_poses(
-      scan, T, [&](double t) -> std::optional<Eigen::Isometry3d> { return T * sweep.at(t); });
-  return placement;
 }
 
 std::string metres_text(double m) {
@@ -127,18 +116,20 @@ struct Localizer::State {
     before_last.reset();
   }
 
-  Fit register_to_map(const slam::Scan& scan, const slam::ScanPlacement& motion,
-                      const Eigen::Isometry3d& guess) {
+  /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to the map from
+  /// `guess`: at every voxel size, or at the finest alone.
+  Fit fit_to_map(const slam::refine::GaussianCloud& cloud, const Eigen::Isometry3d& guess,
+                 bool finest_only) {
     Fit fit;
-    const slam::refine::GaussianCloud cloud =
-        slam::refine::refinement_cloud(scan, motion, settings.voxel_m, settings.neighbours);
     fit.points = cloud.size();
     fit.result.T_target_source = guess;
     // Too few points to say anything: neither a fit nor a contradiction.
     constexpr size_t kMinPoints = 30;
     if (cloud.size() < kMinPoints) return fit;
     const std::shared_ptr<const MapTarget> target = targets.around(guess.translation());
-    fit.result = slam::refine::align(target->vgicp, cloud, guess, settings.vgicp);
+    fit.result = finest_only ? slam::refine::align_to_voxels(target->vgicp.levels.back(), cloud,
+                                                             guess, settings.vgicp)
+                             : slam::refine::align(target->vgicp, cloud, guess, settings.vgicp);
     fit.map = measure_map_fit(*target, cloud, fit.result.T_target_source,
                               settings.vgicp.inlier_distance_m);
     // Where the map saw too little of what the scan sees, the fit says nothing either way.
@@ -168,7 +159,9 @@ struct Localizer::State {
     if (!found) return out;
     // The session's frame here is the odometry's, which starts at the belief.
     const Eigen::Isometry3d guess = found->T_map_session * placed->T_map_sensor;
-    const Fit fit = register_to_map(scan, *placed, guess);
+    const Fit fit = fit_to_map(
+        slam::refine::refinement_cloud(scan, *placed, settings.voxel_m, settings.neighbours), guess,
+        false);
     out.registered = true;
     out.fitness_m = fit.map.fitness_m;
     out.inlier_fraction = fit.map.inlier_fraction;
@@ -233,28 +226,46 @@ struct Localizer::State {
 
   LocalizedScan track(const slam::Scan& scan) {
     // The prediction: the odometry's motion while it runs, else constant velocity.
-    std::optional<slam::ScanPlacement> motion;
     Eigen::Isometry3d predicted = last->T;
+    std::optional<Eigen::Isometry3d> odometry_pose;
+    const auto odometry_start = Clock::now();
     if (odometry) {
       std::string why;
-      motion = odometry->locate(scan, why);
-      if (motion) predicted = T_map_odometry * motion->T_map_sensor;
-    }
-    if (!motion) {
-      slam::SweepMotion sweep;
-      if (before_last) {
-        const double period_s = 1e-9 * static_cast<double>(last->stamp_ns - before_last->stamp_ns);
-        const double elapsed_s = 1e-9 * static_cast<double>(scan.stamp_ns - last->stamp_ns);
-        const Eigen::Isometry3d step = before_last->T.inverse() * last->T;
-        if (period_s > 0.0 && elapsed_s > 0.0) {
-          const Eigen::Isometry3d ahead = slam::motion_fraction(step, elapsed_s / period_s);
-          predicted = last->T * ahead;
-          sweep = slam::SweepMotion(ahead, elapsed_s);
-        }
+      const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
+      if (placed) {
+        odometry_pose = placed->T_map_sensor;
+        predicted = T_map_odometry * placed->T_map_sensor;
       }
-      motion = predicted_placement(scan, predicted, sweep);
     }
-    const Fit fit = register_to_map(scan, *motion, predicted);
+    const double elapsed_s = 1e-9 * static_cast<double>(scan.stamp_ns - last->stamp_ns);
+    if (!odometry_pose && before_last && elapsed_s > 0.0) {
+      const double period_s = 1e-9 * static_cast<double>(last->stamp_ns - before_last->stamp_ns);
+      if (period_s > 0.0) {
+        predicted = last->T *
+                    slam::motion_fraction(before_last->T.inverse() * last->T, elapsed_s / period_s);
+      }
+    }
+    // The sweep's motion to a pose at the stamp, at constant velocity from the last pose.
+    const auto sweep_to = [&](const Eigen::Isometry3d& T) {
+      return elapsed_s > 0.0 ? slam::SweepMotion(last->T.inverse() * T, elapsed_s)
+                             : slam::SweepMotion();
+    };
+    if (odometry) counts.odometry_ms.push_back(ms_since(odometry_start));
+    const auto cloud_start = Clock::now();
+    const TimedScanCloud cloud =
+        timed_scan_cloud(scan, settings.voxel_m, settings.neighbours, settings.max_points);
+    counts.cloud_ms.push_back(ms_since(cloud_start));
+    counts.points_per_scan_sum += cloud.measured.size();
+    const auto register_start = Clock::now();
+    Fit fit = fit_to_map(deskewed(cloud, sweep_to(predicted)), predicted, false);
+    if (fit.result.converged) {
+      // Deskewed again with the motion the registration found, and registered again; where
+      // that does not settle, the first result stands.
+      const Eigen::Isometry3d found = fit.result.T_target_source;
+      Fit again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
+      if (again.result.converged) fit = std::move(again);
+    }
+    counts.register_ms.push_back(ms_since(register_start));
     LocalizedScan out;
     out.registered = fit.points > 0;
     out.fitness_m = fit.map.fitness_m;
@@ -267,8 +278,8 @@ struct Localizer::State {
       status = LocalizeStatus::kLocalized;
       contradicted_in_row = 0;
       on_odometry_since.reset();
-      if (odometry) {
-        T_map_odometry = T * motion->T_map_sensor.inverse();
+      if (odometry && odometry_pose) {
+        T_map_odometry = T * odometry_pose->inverse();
         if (++good_in_row >= settings.settle_scans) odometry.reset();
       }
       remember(scan.stamp_ns, T);

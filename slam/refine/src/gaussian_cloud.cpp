@@ -35,12 +35,18 @@ Eigen::Matrix3d regularised(const Eigen::Matrix3d& covariance) {
 
 }  // namespace
 
-GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int neighbours) {
+GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int neighbours,
+                               std::vector<uint32_t>* kept) {
   std::vector<Eigen::Vector3f> points;
+  std::vector<uint32_t> source_index;
   points.reserve(input.size());
-  for (const Eigen::Vector3f& p : input) {
-    if (p.allFinite()) points.push_back(p);
+  source_index.reserve(input.size());
+  for (size_t i = 0; i < input.size(); ++i) {
+    if (!input[i].allFinite()) continue;
+    points.push_back(input[i]);
+    source_index.push_back(static_cast<uint32_t>(i));
   }
+  if (kept) kept->clear();
   GaussianCloud out;
   const size_t k = static_cast<size_t>(std::max(neighbours, 3));
   if (points.size() < k) return out;
@@ -72,6 +78,7 @@ GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int ne
     if (!good[i]) continue;
     out.points.push_back(points[i].cast<double>());
     out.covariances.push_back(covariances[i]);
+    if (kept) kept->push_back(source_index[i]);
   }
   return out;
 }

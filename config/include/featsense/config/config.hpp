@@ -134,6 +134,7 @@ struct LocalizeConfig {
   double radius_m = 60.0;
   double cache_mb = 512.0;
   double voxel_m = 0.5;
+  int max_points = 3000;
   double min_inlier_fraction = 0.5;
   double max_fitness_m = 0.1;
   double contradiction_fraction = 0.2;

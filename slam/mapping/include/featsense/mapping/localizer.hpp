@@ -49,6 +49,7 @@ struct LocalizerSettings {
   double radius_m = config::LocalizeConfig{}.radius_m;
   size_t cache_bytes = static_cast<size_t>(config::LocalizeConfig{}.cache_mb * 1024 * 1024);
   double voxel_m = config::LocalizeConfig{}.voxel_m;
+  size_t max_points = static_cast<size_t>(config::LocalizeConfig{}.max_points);
   double min_inlier_fraction = config::LocalizeConfig{}.min_inlier_fraction;
   double max_fitness_m = config::LocalizeConfig{}.max_fitness_m;
   double contradiction_fraction = config::LocalizeConfig{}.contradiction_fraction;
@@ -109,7 +110,13 @@ struct LocalizerCounts {
   size_t unconfirmed_matches = 0;           ///< keyframe matches the map's surface did not confirm
   std::optional<LocalizationFix> first_fix;
   std::vector<double> tracking_ms;  ///< per scan registered while localized or on odometry
-  std::vector<double> search_ms;    ///< per scan while lost
+  /// Parts of the tracking, per scan: the odometry (while it runs), the scan's cloud, the
+  /// registrations to the map.
+  std::vector<double> odometry_ms;
+  std::vector<double> cloud_ms;
+  std::vector<double> register_ms;
+  size_t points_per_scan_sum = 0;
+  std::vector<double> search_ms;  ///< per scan while lost
   size_t map_keyframes = 0;
   size_t map_chunks = 0;
   /// The map's surface: chunks read, reused, the cache's bytes.

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <vector>
 
 namespace featsense::slam::refine {
@@ -20,7 +21,9 @@ struct GaussianCloud {
 /// plane-like as GICP does: the eigenvalues replaced by (1, 1, 1e-3) so that every surface
 /// counts by its shape, not by how densely or noisily it was sampled. Points with fewer than
 /// 3 finite neighbours, and non-finite points, are dropped.
-GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& points, int neighbours);
+/// `kept`, where given, receives the index in `points` of each point of the result.
+GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& points, int neighbours,
+                               std::vector<uint32_t>* kept = nullptr);
 
 /// The cloud moved by T: points T p, covariances R C R^T.
 GaussianCloud transformed(const GaussianCloud& cloud, const Eigen::Isometry3d& T);
