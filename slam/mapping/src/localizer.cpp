@@ -75,6 +75,9 @@ std::string metres_text(double m) {
 
 }  // namespace
 
+/// Too few points to say anything: neither a fit nor a contradiction.
+constexpr size_t kMinPoints = 30;
+
 struct Localizer::State {
   State(const std::filesystem::path& map, const config::Config& config_in,
         const std::optional<Eigen::Isometry3d>& initial)
@@ -123,8 +126,6 @@ struct Localizer::State {
     Fit fit;
     fit.points = cloud.size();
     fit.result.T_target_source = guess;
-    // Too few points to say anything: neither a fit nor a contradiction.
-    constexpr size_t kMinPoints = 30;
     if (cloud.size() < kMinPoints) return fit;
     const std::shared_ptr<const MapTarget> target = targets.around(guess.translation());
     fit.result = finest_only ? slam::refine::align_to_voxels(target->vgicp.levels.back(), cloud,
@@ -134,8 +135,9 @@ struct Localizer::State {
                               settings.vgicp.inlier_distance_m);
     // Where the map saw too little of what the scan sees, the fit says nothing either way.
     const bool telling = fit.map.observed >= settings.min_observed_points;
-    fit.good = telling && fit.result.converged &&
-               fit.map.inlier_fraction >= settings.min_inlier_fraction &&
+    // Whether the solver's last step was small enough matters less than where it ended: a
+    // registration that ran out of iterations a millimetre from its minimum still fits.
+    fit.good = telling && fit.map.inlier_fraction >= settings.min_inlier_fraction &&
                fit.map.fitness_m <= settings.max_fitness_m;
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
     return fit;
@@ -257,14 +259,16 @@ struct Localizer::State {
     counts.cloud_ms.push_back(ms_since(cloud_start));
     counts.points_per_scan_sum += cloud.measured.size();
     const auto register_start = Clock::now();
-    Fit fit = fit_to_map(deskewed(cloud, sweep_to(predicted)), predicted, false);
-    if (fit.result.converged) {
-      // Deskewed again with the motion the registration found, and registered again; where
-      // that does not settle, the first result stands.
-      const Eigen::Isometry3d found = fit.result.T_target_source;
-      Fit again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
-      if (again.result.converged) fit = std::move(again);
+    // Registered at every voxel size from the prediction, deskewed with the predicted motion;
+    // then deskewed again with the motion that found, and registered again at the finest.
+    Eigen::Isometry3d found = predicted;
+    if (cloud.measured.size() >= kMinPoints) {
+      const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
+      found = slam::refine::align(target->vgicp, deskewed(cloud, sweep_to(predicted)), predicted,
+                                  settings.vgicp)
+                  .T_target_source;
     }
+    const Fit fit = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
     counts.register_ms.push_back(ms_since(register_start));
     LocalizedScan out;
     out.registered = fit.points > 0;

@@ -55,17 +55,14 @@ TimedScanCloud timed_scan_cloud(const slam::Scan& scan, double voxel_m, int neig
   }
   // The neighbourhoods are those of every voxel's centroid: a thinned cloud's nearest points
   // lie several voxels apart and span corners.
+  const size_t every = max_points > 0 && centroids.size() > max_points
+                           ? (centroids.size() + max_points - 1) / max_points
+                           : 1;
   std::vector<uint32_t> kept;
-  const slam::refine::GaussianCloud all =
-      slam::refine::with_covariances(centroids, neighbours, &kept);
-  const size_t stride =
-      max_points > 0 && all.size() > max_points ? (all.size() + max_points - 1) / max_points : 1;
   TimedScanCloud out;
-  for (size_t i = 0; i < all.size(); i += stride) {
-    out.measured.points.push_back(all.points[i]);
-    out.measured.covariances.push_back(all.covariances[i]);
-    out.times_s.push_back(times[kept[i]]);
-  }
+  out.measured = slam::refine::with_covariances(centroids, neighbours, &kept, every);
+  out.times_s.reserve(kept.size());
+  for (const uint32_t i : kept) out.times_s.push_back(times[i]);
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <nanoflann.hpp>
 
+#include <algorithm>
 #include <vector>
 
 namespace featsense::slam::refine {
@@ -36,7 +37,8 @@ Eigen::Matrix3d regularised(const Eigen::Matrix3d& covariance) {
 }  // namespace
 
 GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int neighbours,
-                               std::vector<uint32_t>* kept) {
+                               std::vector<uint32_t>* kept, size_t every) {
+  every = std::max<size_t>(every, 1);
   std::vector<Eigen::Vector3f> points;
   std::vector<uint32_t> source_index;
   points.reserve(input.size());
@@ -59,6 +61,7 @@ GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int ne
                       std::vector<uint32_t> index(k);
                       std::vector<float> distance2(k);
                       for (size_t i = range.begin(); i < range.end(); ++i) {
+                        if (i % every != 0) continue;
                         const size_t n =
                             tree.knnSearch(points[i].data(), k, index.data(), distance2.data());
                         if (n < 3) continue;
@@ -74,7 +77,7 @@ GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int ne
                         good[i] = covariances[i].allFinite();
                       }
                     });
-  for (size_t i = 0; i < points.size(); ++i) {
+  for (size_t i = 0; i < points.size(); i += every) {
     if (!good[i]) continue;
     out.points.push_back(points[i].cast<double>());
     out.covariances.push_back(covariances[i]);

@@ -21,9 +21,10 @@ struct GaussianCloud {
 /// plane-like as GICP does: the eigenvalues replaced by (1, 1, 1e-3) so that every surface
 /// counts by its shape, not by how densely or noisily it was sampled. Points with fewer than
 /// 3 finite neighbours, and non-finite points, are dropped.
-/// `kept`, where given, receives the index in `points` of each point of the result.
+/// `kept`, where given, receives the index in `points` of each point of the result. With
+/// `every` > 1 only every such finite point is kept (its neighbours still found among all).
 GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& points, int neighbours,
-                               std::vector<uint32_t>* kept = nullptr);
+                               std::vector<uint32_t>* kept = nullptr, size_t every = 1);
 
 /// The cloud moved by T: points T p, covariances R C R^T.
 GaussianCloud transformed(const GaussianCloud& cloud, const Eigen::Isometry3d& T);
