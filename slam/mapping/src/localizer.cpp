@@ -131,16 +131,23 @@ struct Localizer::State {
     fit.result = finest_only ? slam::refine::align_to_voxels(target->vgicp.levels.back(), cloud,
                                                              guess, settings.vgicp)
                              : slam::refine::align(target->vgicp, cloud, guess, settings.vgicp);
-    fit.map = measure_map_fit(*target, cloud, fit.result.T_target_source,
+    judge(*target, cloud, fit);
+    return fit;
+  }
+
+  /// How `fit.result` fits the map, and whether that is a fit, a contradiction, or neither.
+  void judge(const MapTarget& target, const slam::refine::GaussianCloud& cloud, Fit& fit) const {
+    fit.map = measure_map_fit(target, cloud, fit.result.T_target_source,
                               settings.vgicp.inlier_distance_m);
     // Where the map saw too little of what the scan sees, the fit says nothing either way.
     const bool telling = fit.map.observed >= settings.min_observed_points;
-    // Whether the solver's last step was small enough matters less than where it ended: a
-    // registration that ran out of iterations a millimetre from its minimum still fits.
-    fit.good = telling && fit.map.inlier_fraction >= settings.min_inlier_fraction &&
+    const bool enough = telling && fit.map.coverage >= settings.min_coverage;
+    // A registration still moving when its iterations ran out is not a fit, however well it
+    // fits where it stopped: it may be sliding along a street.
+    fit.good = enough && fit.result.converged &&
+               fit.map.inlier_fraction >= settings.min_inlier_fraction &&
                fit.map.fitness_m <= settings.max_fitness_m;
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
-    return fit;
   }
 
   void remember(int64_t stamp_ns, const Eigen::Isometry3d& T) {
@@ -261,14 +268,26 @@ struct Localizer::State {
     const auto register_start = Clock::now();
     // Registered at every voxel size from the prediction, deskewed with the predicted motion;
     // then deskewed again with the motion that found, and registered again at the finest.
-    Eigen::Isometry3d found = predicted;
+    // Where the second does not settle, the first stands.
+    Fit fit;
     if (cloud.measured.size() >= kMinPoints) {
       const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
-      found = slam::refine::align(target->vgicp, deskewed(cloud, sweep_to(predicted)), predicted,
-                                  settings.vgicp)
-                  .T_target_source;
+      const slam::refine::GaussianCloud first_cloud = deskewed(cloud, sweep_to(predicted));
+      fit.points = first_cloud.size();
+      fit.result = slam::refine::align(target->vgicp, first_cloud, predicted, settings.vgicp);
+      Fit again;
+      if (fit.result.converged) {
+        const Eigen::Isometry3d found = fit.result.T_target_source;
+        again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
+      }
+      if (again.result.converged) {
+        fit = std::move(again);
+      } else {
+        judge(*target, first_cloud, fit);
+      }
+    } else {
+      fit.result.T_target_source = predicted;
     }
-    const Fit fit = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
     counts.register_ms.push_back(ms_since(register_start));
     LocalizedScan out;
     out.registered = fit.points > 0;

@@ -58,8 +58,11 @@ struct LocalizerSettings {
   /// The registration to the map: from a prediction a few centimetres off, so a few coarse
   /// iterations and fine voxels (the finest is the cell the map's surface is summed in).
   slam::refine::VgicpSettings vgicp = tracking_vgicp();
-  /// A fit needs this many of the scan's points where the map observed anything.
+  /// A fit needs this many of the scan's points where the map observed anything, and this
+  /// share of them: a scan the map saw little of (a street it only glimpsed from a crossing)
+  /// can fit the little it saw well at a pose a few decimetres off.
   size_t min_observed_points = 50;
+  double min_coverage = 0.25;
   /// Covariances of a scan's points from this many nearest.
   int neighbours = 10;
   /// Voxels of the map's surface observed at least this much (as its mesh's).

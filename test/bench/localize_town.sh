@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Localization in a saved map of the town: the loop mapped once (odometry, loops, gravity; the
+# map's frame is the simulation's, the run starting from the true first pose), then recordings
+# the map never saw localized in it with their truth beside them.
+#
+#   localize_town.sh WORK [PATH ...]     (default paths: drive walk)
+#
+# WORK/town_loop, WORK/loop_map (featsense simulate --scene town --path loop --seed 4; featsense
+# map --no-mesh: about 30 min on 2 cores) and WORK/town_PATH (featsense simulate --path PATH)
+# are made where missing. Each run writes WORK/loc_PATH/ (trajectory.tum, localization.csv,
+# report.json with eval against the truth) and WORK/loc_PATH.time.txt (/usr/bin/time -v), and
+# prints one JSON line: the first fix, the scans by status, the errors of the localized poses,
+# tracking time and peak memory. FEATSENSE names the program (default: build/app/featsense).
+set -euo pipefail
+work=$1
+shift
+paths=("$@")
+[ ${#paths[@]} -gt 0 ] || paths=(drive walk)
+featsense=${FEATSENSE:-build/app/featsense}
+mkdir -p "$work"
+[ -d "$work/town_loop" ] ||
+  "$featsense" simulate --quiet --scene town --path loop --seed 4 -o "$work/town_loop"
+[ -f "$work/loop_map/map.h5" ] ||
+  "$featsense" map --quiet "$work/town_loop" -o "$work/loop_map" --no-mesh
+for path in "${paths[@]}"; do
+  case $path in drive) seed=8 ;; walk) seed=7 ;; *) seed=9 ;; esac
+  [ -d "$work/town_$path" ] ||
+    "$featsense" simulate --quiet --scene town --path "$path" --seed $seed -o "$work/town_$path"
+  /usr/bin/time -v -o "$work/loc_$path.time.txt" "$featsense" localize --quiet \
+    "$work/loop_map/map.h5" "$work/town_$path" -o "$work/loc_$path" \
+    --gt "$work/town_$path/gt_trajectory.tum" || true
+  python3 - "$work/loc_$path/report.json" "$path" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+loc, ev, t = r["localization"], r.get("eval", {}), r["timings"]
+fix = loc.get("first_fix", {})
+out = {"path": sys.argv[2], "frames": r["frames"], "scans": loc["scans"],
+       "first_fix_s": fix.get("seconds_in"), "found_by": fix.get("found_by"),
+       "localized_share_after_first_fix": loc.get("localized_share_after_first_fix"),
+       "losses": loc["losses"],
+       "localized_error_m": ev.get("localized", {}).get("translation_m"),
+       "localized_error_deg": ev.get("localized", {}).get("rotation_deg"),
+       "localized_over_0_5_m": ev.get("localized_over_0_5_m"),
+       "tracking_ms": {k: t["tracking"][k] for k in ("median_ms", "p95_ms")},
+       "tracking_parts_median_ms": {k: v["median_ms"] for k, v in t["tracking_parts"].items()
+                                    if isinstance(v, dict)},
+       "search_total_s": t["search_total_s"], "peak_rss_mb": r["peak_rss_mb"],
+       "map_cache": r["map_cache"]}
+print(json.dumps(out))
+PY
+done
