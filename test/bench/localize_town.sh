@@ -3,7 +3,10 @@
 # map's frame is the simulation's, the run starting from the true first pose), then recordings
 # the map never saw localized in it with their truth beside them.
 #
-#   localize_town.sh WORK [PATH ...]     (default paths: drive walk)
+#   localize_town.sh WORK [PATH ...]     (default paths: drive walk kidnap)
+#
+# kidnap is the drive with its scans 400-659 cut out (splice_recording.py): between two sweeps
+# the sensor is 114 m away, on another street.
 #
 # WORK/town_loop, WORK/loop_map (featsense simulate --scene town --path loop --seed 4; featsense
 # map --no-mesh: about 30 min on 2 cores) and WORK/town_PATH (featsense simulate --path PATH)
@@ -15,15 +18,22 @@ set -euo pipefail
 work=$1
 shift
 paths=("$@")
-[ ${#paths[@]} -gt 0 ] || paths=(drive walk)
+[ ${#paths[@]} -gt 0 ] || paths=(drive walk kidnap)
 featsense=${FEATSENSE:-build/app/featsense}
 mkdir -p "$work"
 [ -d "$work/town_loop" ] ||
   "$featsense" simulate --quiet --scene town --path loop --seed 4 -o "$work/town_loop"
 [ -f "$work/loop_map/map.h5" ] ||
   "$featsense" map --quiet "$work/town_loop" -o "$work/loop_map" --no-mesh
+here=$(dirname "$0")
 for path in "${paths[@]}"; do
   case $path in drive) seed=8 ;; walk) seed=7 ;; *) seed=9 ;; esac
+  if [ "$path" = kidnap ]; then
+    [ -d "$work/town_drive" ] ||
+      "$featsense" simulate --quiet --scene town --path drive --seed 8 -o "$work/town_drive"
+    [ -d "$work/town_kidnap" ] ||
+      python3 "$here/splice_recording.py" "$work/town_drive" "$work/town_kidnap" 0:399 660:901
+  fi
   [ -d "$work/town_$path" ] ||
     "$featsense" simulate --quiet --scene town --path "$path" --seed $seed -o "$work/town_$path"
   /usr/bin/time -v -o "$work/loc_$path.time.txt" "$featsense" localize --quiet \

@@ -12,6 +12,7 @@
 #include "featsense/slam/loops/relocalizer.hpp"
 #include "featsense/slam/odometry/odometry_locator.hpp"
 #include "featsense/slam/refine/refinement_cloud.hpp"
+#include "featsense/slam/trajectory/gyro_rotation.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "map_surface.hpp"
@@ -250,13 +251,28 @@ struct Localizer::State {
     if (!odometry_pose && before_last && elapsed_s > 0.0) {
       const double period_s = 1e-9 * static_cast<double>(last->stamp_ns - before_last->stamp_ns);
       if (period_s > 0.0) {
-        predicted = last->T *
-                    slam::motion_fraction(before_last->T.inverse() * last->T, elapsed_s / period_s);
+        // Constant velocity, its turn replaced by the gyroscope's where the scans carry it:
+        // round a corner the turn rate changes faster than a repeated motion follows.
+        const Eigen::Isometry3d last_motion = before_last->T.inverse() * last->T;
+        const double ratio = elapsed_s / period_s;
+        Eigen::Isometry3d motion = slam::motion_fraction(last_motion, ratio);
+        const std::optional<Eigen::Matrix3d> turn_before =
+            slam::gyro_rotation(earlier_imu, last_imu, before_last->stamp_ns, last->stamp_ns);
+        const std::optional<Eigen::Matrix3d> turn_now =
+            slam::gyro_rotation(last_imu, scan.imu, last->stamp_ns, scan.stamp_ns);
+        if (turn_before && turn_now) {
+          motion =
+              slam::gyro_corrected_prediction(motion, last_motion, *turn_before, *turn_now, ratio);
+        }
+        predicted = last->T * motion;
       }
     }
-    // The sweep's motion to a pose at the stamp, at constant velocity from the last pose.
+    // The sweep's motion to a pose at the stamp: constant velocity from the last pose, bent by
+    // the gyroscope's change of turn rate within the sweep where there is one.
+    const slam::GyroTwist twist = slam::GyroTwist::from_samples(last_imu, scan.imu, last->stamp_ns,
+                                                                scan.stamp_ns, scan.stamp_ns);
     const auto sweep_to = [&](const Eigen::Isometry3d& T) {
-      return elapsed_s > 0.0 ? slam::SweepMotion(last->T.inverse() * T, elapsed_s)
+      return elapsed_s > 0.0 ? slam::SweepMotion(last->T.inverse() * T, elapsed_s, twist)
                              : slam::SweepMotion();
     };
     if (odometry) counts.odometry_ms.push_back(ms_since(odometry_start));
@@ -358,6 +374,9 @@ struct Localizer::State {
   std::optional<Eigen::Isometry3d> search_belief;
   std::optional<Pose> last;
   std::optional<Pose> before_last;
+  /// The IMU's samples of the last two scans, for the gyroscope's turn.
+  std::vector<slam::ImuSample> last_imu;
+  std::vector<slam::ImuSample> earlier_imu;
   size_t good_in_row = 0;
   size_t contradicted_in_row = 0;
   std::optional<int64_t> on_odometry_since;
@@ -411,6 +430,8 @@ LocalizedScan Localizer::add_scan(const slam::Scan& scan) {
   const auto start = Clock::now();
   const bool tracking = s.status != LocalizeStatus::kLost;
   LocalizedScan out = tracking ? s.track(scan) : s.search(scan);
+  s.earlier_imu = std::move(s.last_imu);
+  s.last_imu = scan.imu;
   out.sequence = scan.sequence;
   out.stamp_ns = scan.stamp_ns;
   out.ms = ms_since(start);
