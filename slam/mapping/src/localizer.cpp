@@ -110,12 +110,12 @@ struct Localizer::State {
     odometry = slam::odometry::make_odometry_locator(
         config, belief.value_or(Eigen::Isometry3d::Identity()));
     T_map_odometry = Eigen::Isometry3d::Identity();
-    slam::loops::RelocalizeSettings reloc = relocalize;
-    if (belief) reloc.guess = Eigen::Isometry3d::Identity();
-    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, reloc);
-    selector = std::make_unique<slam::loops::KeyframeSelector>(reloc.loop.keyframe_distance_m,
-                                                               reloc.loop.keyframe_angle_deg);
-    search_belief = belief;
+    // The odometry's frame starts at the belief: the session lies where the belief says.
+    search_settings = relocalize;
+    if (belief) search_settings.guess = Eigen::Isometry3d::Identity();
+    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
+    selector = std::make_unique<slam::loops::KeyframeSelector>(
+        search_settings.loop.keyframe_distance_m, search_settings.loop.keyframe_angle_deg);
     last.reset();
     before_last.reset();
   }
@@ -184,9 +184,7 @@ struct Localizer::State {
                   " % of the scan on it): searching on";
       // The relocalizer keeps a placement once made; a fresh one searches on, with the same
       // odometry.
-      slam::loops::RelocalizeSettings reloc = relocalize;
-      if (search_belief) reloc.guess = Eigen::Isometry3d::Identity();
-      relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, reloc);
+      relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
       return out;
     }
     const Eigen::Isometry3d T = fit.result.T_target_source;
@@ -371,7 +369,8 @@ struct Localizer::State {
   Eigen::Isometry3d T_map_odometry = Eigen::Isometry3d::Identity();
   std::unique_ptr<slam::loops::Relocalizer> relocalizer;
   std::unique_ptr<slam::loops::KeyframeSelector> selector;
-  std::optional<Eigen::Isometry3d> search_belief;
+  /// The current search's settings: relocalize.*, with the guess where it has a belief.
+  slam::loops::RelocalizeSettings search_settings;
   std::optional<Pose> last;
   std::optional<Pose> before_last;
   /// The IMU's samples of the last two scans, for the gyroscope's turn.

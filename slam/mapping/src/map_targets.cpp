@@ -85,14 +85,12 @@ std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre
   slam::refine::VoxelGaussians fitness(parts, vgicp_.fitness_voxel_m);
   auto made = std::make_shared<MapTarget>(
       centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
-  made->cells = parts.size();
   made->observed = std::move(observed);
   made->block_m = block_m_;
   std::shared_ptr<const MapTarget> target = std::move(made);
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.built;
   counts_.build_ms += ms_since(start);
-  counts_.last_cells = parts.size();
   return target;
 }
 

@@ -27,7 +27,6 @@ struct MapTarget {
       : centre(centre_in), vgicp(std::move(vgicp_in)) {}
   Eigen::Vector3d centre;
   slam::refine::VgicpTarget vgicp;
-  size_t cells = 0;
   /// grid_key() of the blocks (block_m across) where the map observed anything.
   std::unordered_set<uint64_t> observed;
   double block_m = 0.5;
@@ -53,7 +52,6 @@ struct MapTargetCounts {
   size_t waited = 0;  ///< targets the tracking had to wait for
   double build_ms = 0.0;
   double wait_ms = 0.0;
-  size_t last_cells = 0;
 };
 
 class MapTargets {
