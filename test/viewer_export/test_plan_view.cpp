@@ -222,6 +222,27 @@ TEST(PlanView, TheTruthIsDrawnBlueBesideTheEstimate) {
   EXPECT_TRUE(is_red(plan.rgba(5.0, 2.0)));
 }
 
+// A localizer's path: red where localized, amber where on odometry, a gap where lost (a
+// non-finite position), with no line across it.
+TEST(PlanView, AGapInAPathIsLeftOpenAndUncertainStretchesAreAmber) {
+  const Eigen::Vector3d gap = Eigen::Vector3d::Constant(std::nan(""));
+  PlanPath localized;
+  localized.label = "localized";
+  localized.positions_m = {{1, 2, 1.5}, {3, 2, 1.5}, gap, gap, {7, 2, 1.5}, {9, 2, 1.5}};
+  PlanPath odometry;
+  odometry.kind = PlanPath::Kind::kUncertain;
+  odometry.label = "on odometry";
+  odometry.positions_m = {gap, gap, gap, gap, gap, gap, {9, 2, 1.5}, {9, 6, 1.5}};
+  const Plan plan{render_plan_view(room(), {localized, odometry}, fixed_pixels())};
+  EXPECT_TRUE(is_red(plan.rgba(2.0, 2.0)));
+  EXPECT_TRUE(is_red(plan.rgba(8.0, 2.0)));
+  EXPECT_FALSE(is_red(plan.rgba(5.0, 2.0)));  // lost between 3 and 7 m
+  const unsigned char* amber = plan.rgba(9.0, 4.0);
+  EXPECT_GT(amber[0], 200);
+  EXPECT_GT(amber[1], 120);
+  EXPECT_LT(amber[2], 80);
+}
+
 // Surfaces in their vertices' colours (mesh_error.png): the room's floor, in the colour its
 // vertices carry, where the height ramp would be; its walls too; the cut and the path as ever.
 TEST(PlanView, VertexColoursReplaceTheHeightColours) {

@@ -12,6 +12,7 @@ namespace {
 // Channels are RGBA, as the PNG stores them.
 const cv::Scalar kEstimateColour(215, 25, 28, 255);
 const cv::Scalar kTruthColour(35, 100, 220, 255);
+const cv::Scalar kUncertainColour(245, 160, 20, 255);
 const cv::Scalar kInk(20, 20, 20, 255);
 const cv::Scalar kPaper(255, 255, 255, 255);
 const cv::Scalar kFrame(150, 150, 150, 255);
@@ -33,7 +34,15 @@ void put_text(cv::Mat& image, const std::string& text, int x, int baseline_y,
 }
 
 const cv::Scalar& colour_of(PlanPath::Kind kind) {
-  return kind == PlanPath::Kind::kTruth ? kTruthColour : kEstimateColour;
+  switch (kind) {
+    case PlanPath::Kind::kTruth:
+      return kTruthColour;
+    case PlanPath::Kind::kUncertain:
+      return kUncertainColour;
+    case PlanPath::Kind::kEstimate:
+      break;
+  }
+  return kEstimateColour;
 }
 
 }  // namespace
@@ -96,23 +105,35 @@ void draw_paths(std::vector<uint8_t>& rgba, const PlanFrame& frame, const PlanSt
   // Sub-pixel positions: OpenCV's fixed point with 4 fractional bits.
   constexpr int kShift = 4;
   constexpr double kScale = 1 << kShift;
-  for (const PlanPath::Kind kind : {PlanPath::Kind::kTruth, PlanPath::Kind::kEstimate}) {
-    // The truth wider, below: where an estimate lies on it, both show (red edged in blue).
+  // The truth first, wider: where an estimate lies on it, both show (red edged in blue).
+  for (const PlanPath::Kind kind :
+       {PlanPath::Kind::kTruth, PlanPath::Kind::kUncertain, PlanPath::Kind::kEstimate}) {
     const int line = kind == PlanPath::Kind::kTruth ? style.path_width + 2 : style.path_width;
     for (const PlanPath& path : paths) {
-      if (path.kind != kind || path.positions_m.empty()) continue;
+      if (path.kind != kind) continue;
+      bool started = false;
       std::vector<cv::Point> points;
-      points.reserve(path.positions_m.size());
+      const auto draw_piece = [&] {
+        if (points.empty()) return;
+        cv::polylines(image, points, false, colour_of(kind), line, cv::LINE_AA, kShift);
+        // The path's start as a dot; a piece after a gap starts without one.
+        if (!started) {
+          cv::circle(image, points.front(), static_cast<int>((line + 2) * kScale), colour_of(kind),
+                     cv::FILLED, cv::LINE_AA, kShift);
+        }
+        started = true;
+        points.clear();
+      };
       for (const Eigen::Vector3d& p : path.positions_m) {
-        if (!p.allFinite()) continue;
+        if (!p.allFinite()) {
+          draw_piece();
+          continue;
+        }
         const cv::Point point(static_cast<int>(std::lround(frame.column_of(p.x()) * kScale)),
                               static_cast<int>(std::lround(frame.row_of(p.y()) * kScale)));
         if (points.empty() || point != points.back()) points.push_back(point);
       }
-      if (points.empty()) continue;
-      cv::polylines(image, points, false, colour_of(kind), line, cv::LINE_AA, kShift);
-      cv::circle(image, points.front(), static_cast<int>((line + 2) * kScale), colour_of(kind),
-                 cv::FILLED, cv::LINE_AA, kShift);
+      draw_piece();
     }
   }
 }

@@ -18,9 +18,12 @@
 
 namespace featsense::viewer_export {
 
-/// A path drawn on the plan: the positions of the sensor, map frame, metres.
+/// A path drawn on the plan: the positions of the sensor, map frame, metres. A non-finite
+/// position is a gap: the line stops there and goes on at the next position.
 struct PlanPath {
-  enum class Kind { kEstimate, kTruth };  ///< estimate: red, truth: blue, drawn below
+  /// estimate: red; truth: blue, wider and drawn below; uncertain: amber, an estimate held
+  /// with less confidence (a localizer's poses on odometry alone), drawn below the estimate.
+  enum class Kind { kEstimate, kTruth, kUncertain };
   Kind kind = Kind::kEstimate;
   std::string label;  ///< the legend's text
   std::vector<Eigen::Vector3d> positions_m;
