@@ -3,6 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/scene_library.hpp"
 
@@ -43,6 +49,42 @@ TEST(SimSceneLibrary, SizesAsSpecified) {
     }
   }
   EXPECT_GT(foliage, 5000u);
+}
+
+/// The vertices of the mesh's triangles of cars (`cars`) or of everything else, in order.
+std::vector<Eigen::Vector3f> vertices_of(const mesh::TriangleMesh& m, bool cars) {
+  std::vector<Eigen::Vector3f> out;
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    const std::string& part = m.parts[m.triangle_part[t]].name;
+    const bool car = part == "car body" || part == "car window" || part == "tyre";
+    if (car != cars) continue;
+    for (int k = 0; k < 3; ++k) out.push_back(m.vertices[static_cast<size_t>(m.triangles[t][k])]);
+  }
+  return out;
+}
+
+TEST(SimSceneLibrary, TheTownOnAnotherDayHasOnlyItsParkedCarsMoved) {
+  const mesh::TriangleMesh mapped = build_scene("town");
+  const mesh::TriangleMesh changed = build_scene("town-changed");
+  // Everything but the cars the same, triangle for triangle.
+  EXPECT_EQ(vertices_of(mapped, false), vertices_of(changed, false));
+  // The cars: about as many (60 % of the bays taken either day), hardly any where they were.
+  const std::vector<Eigen::Vector3f> before = vertices_of(mapped, true);
+  const std::vector<Eigen::Vector3f> after = vertices_of(changed, true);
+  ASSERT_GT(before.size(), 1000u);
+  EXPECT_NEAR(static_cast<double>(after.size()) / static_cast<double>(before.size()), 1.0, 0.25);
+  std::set<std::array<int, 3>> cells_before;
+  for (const Eigen::Vector3f& v : before)
+    cells_before.insert({static_cast<int>(std::floor(v.x() / 0.5f)),
+                         static_cast<int>(std::floor(v.y() / 0.5f)),
+                         static_cast<int>(std::floor(v.z() / 0.5f))});
+  size_t same_cell = 0;
+  for (const Eigen::Vector3f& v : after)
+    same_cell += cells_before.count({static_cast<int>(std::floor(v.x() / 0.5f)),
+                                     static_cast<int>(std::floor(v.y() / 0.5f)),
+                                     static_cast<int>(std::floor(v.z() / 0.5f))});
+  // Cars of the same bay overlap in part: most of another day's car is elsewhere.
+  EXPECT_LT(static_cast<double>(same_cell) / static_cast<double>(after.size()), 0.6);
 }
 
 TEST(SimSceneLibrary, NamedPathsStayInsideAndClearOfObstacles) {

@@ -164,7 +164,9 @@ std::vector<Eigen::Vector3d> parking_loop() {
 
 }  // namespace
 
-std::vector<std::string> scene_names() { return {"corridor", "lab", "parking", "town"}; }
+std::vector<std::string> scene_names() {
+  return {"corridor", "lab", "parking", "town", "town-changed"};
+}
 
 bool is_builtin_scene(const std::string& name) {
   for (const std::string& s : scene_names()) {
@@ -178,12 +180,13 @@ mesh::TriangleMesh build_scene(const std::string& name) {
   if (name == "parking") return parking();
   if (name == "corridor") return corridor();
   if (name == "town") return town::build_town();
+  if (name == "town-changed") return town::build_town(town::ParkedCars::kAnotherDay);
   throw std::invalid_argument(unknown_scene(name));
 }
 
 std::vector<std::string> path_names(const std::string& scene) {
   if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown_scene(scene));
-  if (scene == "town") return town::town_path_names();
+  if (scene == "town" || scene == "town-changed") return town::town_path_names();
   if (scene == "parking") return {"walk", "drive", "drone", "loop"};
   return {"walk", "drive", "drone"};
 }
@@ -194,7 +197,7 @@ NamedPath scene_path(const std::string& scene, const std::string& path) {
   if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown_scene(scene));
   NamedPath out;
   out.name = path;
-  if (scene == "town") {
+  if (scene == "town" || scene == "town-changed") {
     out = town::town_path(path);
   } else if (scene == "lab") {
     if (path == "walk") {

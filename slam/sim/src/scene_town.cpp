@@ -92,7 +92,7 @@ void add_block_buildings(mesh::TriangleMesh& m, uint32_t design, const BlockGrou
 /// Along one side of a block: trees and a light pole on the sidewalk, cars parked at the
 /// kerb (not on sloping streets). `side` 0..3 is south, east, north, west.
 void add_block_side(mesh::TriangleMesh& m, uint32_t design, uint32_t side,
-                    const BlockGround& ground) {
+                    const BlockGround& ground, ParkedCars cars) {
   // A point `along` the side (from its west or south end) `from_kerb` metres into the lot
   // (negative: out into the street), in the block's frame, at the ground's height.
   const auto spot = [&](float along, float from_kerb) {
@@ -134,14 +134,18 @@ void add_block_side(mesh::TriangleMesh& m, uint32_t design, uint32_t side,
   const bool sloping_street = side % 2 == 0 && ground.at(kLotLoM) != ground.at(kLotHiM);
   if (sloping_street) return;
   // Five bays from 5 m after the lot's corner to 6.5 m before the next: corners stay clear.
+  // Another day's cars come from streams of their own: as many bays taken, other ones.
+  const bool another_day = cars == ParkedCars::kAnotherDay;
   for (uint32_t k = 0; k < 5; ++k) {
-    if (draw(26, design, side * 8 + k, 0, 1) < 0.4f) continue;
+    if (draw(another_day ? 27 : 26, design, side * 8 + k, 0, 1) < 0.4f) continue;
     mesh::TriangleMesh car;
-    scene_parts::add_car(car, 0, 0, design * 64 + side * 8 + k,
-                         car.add_part("tyre", Materials::kTyre));
+    const uint32_t model = design * 64 + side * 8 + k + (another_day ? 4096u : 0u);
+    scene_parts::add_car(car, 0, 0, model, car.add_part("tyre", Materials::kTyre));
     // The car is 1.8 x 4.5 m from (0, 0) with its length along y; along a street that runs
-    // along x it is turned a quarter. Its body goes 0.3 to 2.1 m out from the kerb.
-    const float along = 5.0f + 5.5f * static_cast<float>(k);
+    // along x it is turned a quarter. Its body goes 0.3 to 2.1 m out from the kerb. The bays
+    // are 5.5 m apart: half a metre either way keeps neighbours apart.
+    const float shift = another_day ? draw(28, design, side * 8 + k, -0.5f, 0.5f) : 0.0f;
+    const float along = 5.0f + 5.5f * static_cast<float>(k) + shift;
     const V a = spot(along, -0.3f);
     const V b = spot(along + 4.5f, -2.1f);
     const bool along_x = side % 2 == 0;
@@ -150,13 +154,13 @@ void add_block_side(mesh::TriangleMesh& m, uint32_t design, uint32_t side,
   }
 }
 
-mesh::TriangleMesh block(uint32_t design, const BlockGround& ground) {
+mesh::TriangleMesh block(uint32_t design, const BlockGround& ground, ParkedCars cars) {
   mesh::TriangleMesh m;
   const uint32_t kerb = m.add_part("sidewalk", Materials::kConcrete);
   add_slab(m, kLotLoM, kLotLoM, kLotHiM, kLotHiM, ground.at(kLotLoM), ground.at(kLotHiM),
            kKerbHeightM, kerb);
   add_block_buildings(m, design, ground);
-  for (uint32_t side = 0; side < 4; ++side) add_block_side(m, design, side, ground);
+  for (uint32_t side = 0; side < 4; ++side) add_block_side(m, design, side, ground, cars);
   return m;
 }
 
@@ -219,7 +223,7 @@ void add_outer_row(mesh::TriangleMesh& m, uint32_t row, float lo_m, float hi_m) 
 
 }  // namespace
 
-mesh::TriangleMesh build_town() {
+mesh::TriangleMesh build_town(ParkedCars cars) {
   mesh::TriangleMesh m;
   const float town_x = kBlockColumns * kPitchM;
   const float town_y = kBlockRows * kPitchM;
@@ -240,7 +244,7 @@ mesh::TriangleMesh build_town() {
     for (int i = 0; i < kBlockColumns; ++i) {
       const float x = kPitchM * static_cast<float>(i);
       const float y = kPitchM * static_cast<float>(j);
-      append_placed(m, block(block_design(i, j), BlockGround{x}), 0, V(x, y, 0));
+      append_placed(m, block(block_design(i, j), BlockGround{x}, cars), 0, V(x, y, 0));
     }
   }
   return m;

@@ -39,8 +39,12 @@ inline float ground_height_m(float x) {
 constexpr int kTwinI[2] = {0, 2};
 constexpr int kTwinJ = 1;
 
+/// Which day's parked cars: those of the day the town is mapped, or another day's: each bay
+/// drawn anew (taken or empty), a car in it another model, parked up to 0.5 m further along.
+enum class ParkedCars { kMappingDay, kAnotherDay };
+
 /// The mesh (map frame, metres, Z up; roads at z = 0 west of the rise).
-mesh::TriangleMesh build_town();
+mesh::TriangleMesh build_town(ParkedCars cars = ParkedCars::kMappingDay);
 /// "loop", "drive", "walk".
 std::vector<std::string> town_path_names();
 /// The named path, or one without waypoints when `name` is none of town_path_names().
