@@ -13,9 +13,13 @@
 #include "featsense/mapping/localizer.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "json_output.hpp"
+#include "live_input.hpp"
+#include "localization_files.hpp"
+#include "localize_plan.hpp"
 #include "localize_report.hpp"
 #include "map_options.hpp"
 #include "progress.hpp"
+#include "report_html.hpp"
 #include "source_options.hpp"
 #include "stop_signal.hpp"
 
@@ -27,6 +31,8 @@ namespace fs = std::filesystem;
 struct LocalizeOptions {
   std::string map;
   InputOptions input;
+  LiveInputOptions live;  ///< --sensor: the scans from a sensor on the network
+  bool plan = true;       ///< topdown.png: the map around the path (meshes that part of it)
   std::string output;
   std::optional<std::string> initial_pose;
   std::optional<std::string> gt;
@@ -36,6 +42,10 @@ struct LocalizeOptions {
 
 /// A run that never found the sensor in the map: its own exit status, after the report.
 constexpr int kNeverLocalizedExit = 3;
+
+/// How much of the map around the path the plan view shows: enough for the streets and
+/// rooms beside it, not the whole map of a city.
+constexpr double kPlanMarginM = 15.0;
 
 std::string progress_text(const mapping::LocalizerCounts& counts) {
   const auto count = [&](const char* status) {
@@ -55,22 +65,37 @@ void log_summary(const LocalizeRun& run) {
                c.first_fix->scan, progress_text(c));
 }
 
-void run_localize(const LocalizeOptions& options, const CliContext& context) {
+std::unique_ptr<slam::ScanSource> open_input(LocalizeOptions& options, const config::Config& config,
+                                             const StopSignal& stop, bool quiet) {
+  const bool live = !options.live.sensor.empty();
+  // Both at once is refused by the command line (--sensor excludes INPUT).
+  if (!live && options.input.input.empty())
+    throw slam::InputError("nothing to localize: give a recording (INPUT) or a sensor (--sensor)");
+  if (!live) return options.input.open(config);
+  return options.live.open(config, options.input.meta_path, options.output, stop, quiet,
+                           "Ctrl+C ends the run and writes the report");
+}
+
+void run_localize(LocalizeOptions& options, const CliContext& context) {
   const config::Config config = context.load_config();
   std::optional<Eigen::Isometry3d> initial_pose;
   if (options.initial_pose) initial_pose = parse_initial_pose(*options.initial_pose);
   std::optional<slam::Trajectory> truth;
   if (options.gt) truth = slam::read_trajectory(*options.gt, "auto", {});
   fs::create_directories(options.output);
+  const fs::path folder(options.output);
   mapping::Localizer localizer(options.map, config, initial_pose);
-  std::unique_ptr<slam::ScanSource> source = options.input.open(config);
+  const StopSignal stop_signal("finishing the scan in hand and writing the poses");
+  std::unique_ptr<slam::ScanSource> source =
+      open_input(options, config, stop_signal, context.quiet);
   const mapping::LocalizerCounts opened = localizer.counts();
   spdlog::info("localizing {} ({}) in {} ({} keyframes, {} chunks){}", source->info().path,
                source->info().format, options.map, opened.map_keyframes, opened.map_chunks,
                initial_pose ? ", from the given initial pose" : "");
 
-  const StopSignal stop_signal("finishing the scan in hand and writing the poses");
+  // A live source has no length: the progress counts without a total.
   Progress progress("scans", source->info().frames, context.quiet);
+  LocalizationFiles files(folder);
   LocalizeRun run;
   run.map = options.map;
   run.input = source->info();
@@ -82,6 +107,7 @@ void run_localize(const LocalizeOptions& options, const CliContext& context) {
     if (options.end && scan->sequence > *options.end) break;
     run.scans.push_back(localizer.add_scan(*scan));
     const mapping::LocalizedScan& done = run.scans.back();
+    files.add(done);
     if (!done.event.empty()) {
       progress.finish();
       spdlog::info("scan {}: {}", done.sequence, done.event);
@@ -96,16 +122,22 @@ void run_localize(const LocalizeOptions& options, const CliContext& context) {
   run.warnings = source->stats().warning_count;
   run.input = source->info();
 
-  const fs::path folder(options.output);
-  write_localization_files(run, folder);
-  write_json(localize_report_json(config, run, truth), (folder / "report.json").string());
+  nlohmann::json report = localize_report_json(config, run, truth);
+  if (options.plan) {
+    report["localization"]["plan"] = write_localize_plan(run, truth, folder, kPlanMarginM);
+  }
+  report["html"] = kReportHtml;
+  write_json(report, (folder / "report.json").string());
+  write_report_html(folder, report);
   log_summary(run);
   if (!context.quiet) {
-    std::printf("%s: %zu scans, %s; trajectory.tum, localization.csv, report.json in %s\n",
+    std::printf("%s: %zu scans, %s; trajectory.tum, localization.csv, report.json, %s in %s\n",
                 run.counts.first_fix ? "localized" : "not localized", run.scans.size(),
-                progress_text(run.counts).c_str(), folder.string().c_str());
+                progress_text(run.counts).c_str(), kReportHtml, folder.string().c_str());
   }
-  if (run.interrupted) throw Interrupted("localization stopped; what was done is written");
+  // Ctrl+C is how a live run ends; a recording stopped early says so.
+  const bool live = !options.live.sensor.empty();
+  if (run.interrupted && !live) throw Interrupted("localization stopped; what was done is written");
   if (!run.counts.first_fix) {
     throw CommandFailed(
         run.input.path + " was never found in " + options.map + ": none of its " +
@@ -124,12 +156,21 @@ Command register_localize(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<LocalizeOptions>();
   CLI::App* command = app.add_subcommand(
       "localize",
-      "Each scan's pose in a saved map (found from anywhere by the map's keyframes, then "
-      "tracked on its surface); the map is only read. Exit status 3: never found");
+      "Each scan's pose in a saved map, from a recording or a sensor on the network (found "
+      "from anywhere by the map's keyframes, then tracked on its surface); the map is only "
+      "read. Exit status 3: never found");
   command->add_option("MAP", options->map, "A map.h5 made by `featsense map`")
       ->required()
       ->check(CLI::ExistingFile);
-  options->input.add_to(*command, false);
+  options->input.add_to(*command, true);
+  options->live.add_to(*command, false);
+  command->get_option("INPUT")->description(
+      "The recording to localize (a file or folder, as `featsense map` reads), or none with "
+      "--sensor");
+  command->get_option("--sensor")->excludes(command->get_option("INPUT"));
+  command->get_option("--meta")->description(
+      "Ouster metadata JSON: a pcap's (default: found beside it), or with --sensor ouster the "
+      "sensor's (or --sensor-address)");
   command
       ->add_option("-o,--output", options->output,
                    "Folder for trajectory.tum, localization.csv and report.json")
@@ -144,6 +185,8 @@ Command register_localize(CLI::App& app, const CliContext& context) {
       ->check(CLI::ExistingFile);
   command->add_option("--start", options->start, "First scan to localize (index)");
   command->add_option("--end", options->end, "Last scan to localize (index)");
+  command->add_flag("!--no-plan", options->plan,
+                    "No topdown.png (it meshes the map around the path when the run ends)");
   return {command, [options, &context] { run_localize(*options, context); }};
 }
 

@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <stdexcept>
 
 #include "featsense/bench/measurements.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
-#include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
 
 namespace featsense::app {
@@ -99,46 +97,6 @@ nlohmann::json truth_json(const std::vector<LocalizedScan>& scans, const slam::T
 
 }  // namespace
 
-slam::Trajectory posed_path(const std::vector<LocalizedScan>& scans) {
-  slam::Trajectory path;
-  for (const LocalizedScan& scan : scans) {
-    if (scan.T_map_sensor) path.push_back(scan.stamp_ns, *scan.T_map_sensor);
-  }
-  return path;
-}
-
-void write_localization_files(const LocalizeRun& run, const fs::path& folder) {
-  slam::write_tum(posed_path(run.scans), (folder / "trajectory.tum").string());
-  const fs::path csv_path = folder / "localization.csv";
-  std::ofstream csv(csv_path);
-  if (!csv) throw std::runtime_error("cannot write " + csv_path.string());
-  csv << "stamp_s,status,x,y,z,qx,qy,qz,qw,fitness_m,inlier_fraction,coverage,ms\n";
-  char line[400];
-  for (const LocalizedScan& scan : run.scans) {
-    const double t = 1e-9 * static_cast<double>(scan.stamp_ns);
-    if (scan.T_map_sensor) {
-      const Eigen::Vector3d p = scan.T_map_sensor->translation();
-      const Eigen::Quaterniond q(scan.T_map_sensor->rotation());
-      std::snprintf(line, sizeof line, "%.9f,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,", t,
-                    mapping::to_string(scan.status), p.x(), p.y(), p.z(), q.x(), q.y(), q.z(),
-                    q.w());
-    } else {
-      std::snprintf(line, sizeof line, "%.9f,%s,,,,,,,,", t, mapping::to_string(scan.status));
-    }
-    csv << line;
-    if (scan.registered) {
-      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,", scan.fitness_m, scan.inlier_fraction,
-                    scan.coverage);
-      csv << line;
-    } else {
-      csv << ",,,";
-    }
-    std::snprintf(line, sizeof line, "%.2f\n", scan.ms);
-    csv << line;
-  }
-  if (!csv) throw std::runtime_error("cannot write " + csv_path.string());
-}
-
 nlohmann::json localize_report_json(const config::Config& config, const LocalizeRun& run,
                                     const std::optional<slam::Trajectory>& truth) {
   const mapping::LocalizerCounts& c = run.counts;
@@ -186,6 +144,11 @@ nlohmann::json localize_report_json(const config::Config& config, const Localize
   loc["fixes"] = c.fixes;
   loc["losses"] = c.losses;
   loc["unconfirmed_matches"] = c.unconfirmed_matches;
+  loc["search"] = {{"keyframes", c.search_keyframes},
+                   {"candidates", c.search_candidates},
+                   {"verified", c.search_verified},
+                   {"surface_refuted", c.unconfirmed_matches},
+                   {"rejected", c.search_rejected}};
   nlohmann::json events = nlohmann::json::array();
   size_t event_count = 0;
   for (size_t i = 0; i < run.scans.size(); ++i) {

@@ -1,8 +1,7 @@
 #pragma once
-// What `featsense localize` writes: trajectory.tum (every scan with a pose in the map's frame,
-// localized or on odometry), localization.csv (every scan: its status, pose and fit) and
-// report.json (when and where the sensor was found, how long it was lost, the fit and time
-// per scan, the map's cache; the error against a given truth).
+// The report of `featsense localize` (trajectory.tum and localization.csv are written as it
+// goes: localization_files.hpp): report.json (when and where the sensor was found, how long it was
+// lost, the fit and time per scan, the map's cache; the error against a given truth).
 
 #include <nlohmann/json.hpp>
 
@@ -28,12 +27,6 @@ struct LocalizeRun {
   size_t frames_skipped = 0;
   size_t warnings = 0;
 };
-
-/// The poses of the scans that have one (localized or on odometry).
-slam::Trajectory posed_path(const std::vector<mapping::LocalizedScan>& scans);
-
-/// Writes trajectory.tum and localization.csv into `folder`.
-void write_localization_files(const LocalizeRun& run, const std::filesystem::path& folder);
 
 /// The report; with `truth` (poses in the map's frame) each posed scan's error too.
 nlohmann::json localize_report_json(const config::Config& config, const LocalizeRun& run,

@@ -28,18 +28,6 @@ namespace {
 constexpr const char* kOs1Pcap = "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap";
 constexpr const char* kOs1Json = "ouster/OS-1-128_v2.3.0_1024x10.json";
 
-/// Waits until `log` contains `what` (false: the child ended first, or 30 s passed).
-bool wait_for_line(const std::filesystem::path& log, const std::string& what, pid_t child) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (std::chrono::steady_clock::now() < end) {
-    if (text_of(log).find(what) != std::string::npos) return true;
-    int status = 0;
-    if (waitpid(child, &status, WNOHANG) == child) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return false;
-}
-
 TEST(CliLive, AReplayedRecordingMapsAsTheRecordingDoes) {
   FEATSENSE_SHARED_FILE(pcap, kOs1Pcap);
   FEATSENSE_SHARED_FILE(json, kOs1Json);

@@ -1,6 +1,7 @@
 // featsense localize: a recording found in a saved map and tracked on its surface, within
-// centimetres of the truth; a recording of another place never found (its own exit status);
-// the map the same bytes after every run; maps it cannot use refused with one clear message.
+// centimetres of the truth, from a file and from a sensor on the network (a recording
+// replayed); a recording of another place never found (its own exit status); the map the
+// same bytes after every run; maps it cannot use refused with one clear message.
 
 #include <gtest/gtest.h>
 
@@ -17,7 +18,9 @@
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/small_map_options.hpp"
+#include "common/spawn_command.hpp"
 #include "common/test_data.hpp"
+#include "slam/udp_test_util.hpp"
 
 namespace featsense::test {
 namespace {
@@ -140,6 +143,65 @@ TEST_F(CliLocalize, AnotherPathThroughTheMappedRoomIsFoundAndTracked) {
             found["scans"]["localized"].get<size_t>() + found["scans"]["odometry"].get<size_t>());
   EXPECT_TRUE(file_bytes(map()) == map_before) << "the map changed";
   EXPECT_TRUE(file_bytes(map().string() + ".journal") == journal_before) << "its journal changed";
+
+  // The page: the path drawn on the map's plan view, the figures beside it.
+  EXPECT_EQ(report["html"], "report.html");
+  const std::string page = file_bytes(out / "report.html");
+  EXPECT_NE(page.find("featsense localization report"), std::string::npos);
+  EXPECT_NE(page.find("Plan view with the localized path"), std::string::npos);
+  EXPECT_NE(page.find("Against the truth"), std::string::npos);
+  ASSERT_EQ(found["plan"]["file"], "topdown.png") << found["plan"].dump(2);
+  EXPECT_EQ(file_bytes(out / "topdown.png").substr(1, 3), "PNG");
+}
+
+TEST_F(CliLocalize, ASensorOnTheNetworkIsFoundAndTracked) {
+  const fs::path dir = scratch_dir("cli_localize_live");
+  // The drone's flight as the sensor sends it, replayed over the loopback interface.
+  CommandResult run = run_featsense(
+      "simulate --quiet --scene lab --path drone --seed 3 --frames 20 --format ouster-pcap -o " +
+      (dir / "sensor").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const int lidar = free_udp_port();
+  const int imu = free_udp_port();
+  const fs::path log = dir / "localize.log";
+  const pid_t localize = spawn_featsense(
+      "localize " + map().string() + " --sensor ouster --meta " +
+          (dir / "sensor" / "recording.json").string() + " --host 127.0.0.1 --lidar-port " +
+          std::to_string(lidar) + " --imu-port " + std::to_string(imu) +
+          " --idle-timeout 2 --no-plan -o " + (dir / "out").string() + " --gt " +
+          (dir / "sensor" / "gt_trajectory.tum").string(),
+      log);
+  ASSERT_TRUE(wait_for_line(log, "listening on udp://127.0.0.1:", localize)) << text_of(log);
+  run = run_featsense("replay " + (dir / "sensor" / "recording.pcap").string() +
+                      " --quiet --port 7502:" + std::to_string(lidar) +
+                      " --port 7503:" + std::to_string(imu));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(wait_exit_code(localize), 0) << text_of(log);
+
+  const nlohmann::json report = read_json(dir / "out" / "report.json");
+  EXPECT_EQ(report["input"]["format"], "ouster-live");
+  EXPECT_EQ(report["frames"], 20);
+  const nlohmann::json& found = report["localization"];
+  ASSERT_TRUE(found["localized"].get<bool>()) << found.dump(2);
+  EXPECT_GE(found["scans"]["localized"].get<size_t>(), 15u) << found.dump(2);
+  EXPECT_EQ(report["eval"]["localized_over_0_5_m"].get<int>(), 0);
+  EXPECT_LT(report["eval"]["localized"]["translation_m"]["max"].get<double>(), 0.06)
+      << report["eval"].dump(2);
+  // Written as the scans came: one line per scan, a pose for each posed one.
+  EXPECT_EQ(read_status(dir / "out" / "localization.csv").size(), 20u);
+  EXPECT_EQ(read_tum_poses(dir / "out" / "trajectory.tum").size(),
+            found["scans"]["localized"].get<size_t>() + found["scans"]["odometry"].get<size_t>());
+}
+
+TEST_F(CliLocalize, ARecordingOrASensorNotBothNorNeither) {
+  const fs::path out = scratch_dir("cli_localize_inputs");
+  CommandResult run = run_featsense("localize " + map().string() + " " + input("drone").string() +
+                                    " --sensor ouster -o " + out.string());
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("excludes"), std::string::npos) << run.output;
+  run = run_featsense("localize " + map().string() + " -o " + out.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("nothing to localize"), std::string::npos) << run.output;
 }
 
 TEST_F(CliLocalize, ARecordingOfAnotherPlaceIsNeverFound) {

@@ -3,10 +3,12 @@
 # map's frame is the simulation's, the run starting from the true first pose), then recordings
 # the map never saw localized in it with their truth beside them.
 #
-#   localize_town.sh WORK [PATH ...]     (default paths: drive walk kidnap)
+#   localize_town.sh WORK [PATH ...]     (default: drive walk kidnap drive-changed walk-changed)
 #
 # kidnap is the drive with its scans 400-659 cut out (splice_recording.py): between two sweeps
-# the sensor is 114 m away, on another street.
+# the sensor is 114 m away, on another street. drive-changed and walk-changed are the drive
+# and the walk through the town on another day (--scene town-changed: the parked cars moved).
+# lab is the lab walk (another place, an indoor room): it must never be found.
 #
 # WORK/town_loop, WORK/loop_map (featsense simulate --scene town --path loop --seed 4; featsense
 # map --no-mesh: about 30 min on 2 cores) and WORK/town_PATH (featsense simulate --path PATH)
@@ -18,7 +20,7 @@ set -euo pipefail
 work=$1
 shift
 paths=("$@")
-[ ${#paths[@]} -gt 0 ] || paths=(drive walk kidnap)
+[ ${#paths[@]} -gt 0 ] || paths=(drive walk kidnap drive-changed walk-changed)
 featsense=${FEATSENSE:-build/app/featsense}
 mkdir -p "$work"
 [ -d "$work/town_loop" ] ||
@@ -27,24 +29,33 @@ mkdir -p "$work"
   "$featsense" map --quiet "$work/town_loop" -o "$work/loop_map" --no-mesh
 here=$(dirname "$0")
 for path in "${paths[@]}"; do
-  case $path in drive) seed=8 ;; walk) seed=7 ;; *) seed=9 ;; esac
+  scene=town
+  route=${path%-changed}
+  [ "$route" = "$path" ] || scene=town-changed
+  case $route in drive) seed=8 ;; walk) seed=7 ;; *) seed=9 ;; esac
   if [ "$path" = kidnap ]; then
     [ -d "$work/town_drive" ] ||
       "$featsense" simulate --quiet --scene town --path drive --seed 8 -o "$work/town_drive"
     [ -d "$work/town_kidnap" ] ||
       python3 "$here/splice_recording.py" "$work/town_drive" "$work/town_kidnap" 0:399 660:901
   fi
+  if [ "$path" = lab ]; then
+    [ -d "$work/town_lab" ] ||
+      "$featsense" simulate --quiet --scene lab --path walk --seed 5 -o "$work/town_lab"
+  fi
   [ -d "$work/town_$path" ] ||
-    "$featsense" simulate --quiet --scene town --path "$path" --seed $seed -o "$work/town_$path"
+    "$featsense" simulate --quiet --scene $scene --path "$route" --seed $seed -o "$work/town_$path"
+  rc=0
   /usr/bin/time -v -o "$work/loc_$path.time.txt" "$featsense" localize --quiet \
     "$work/loop_map/map.h5" "$work/town_$path" -o "$work/loc_$path" \
-    --gt "$work/town_$path/gt_trajectory.tum" || true
-  python3 - "$work/loc_$path/report.json" "$path" <<'PY'
+    --gt "$work/town_$path/gt_trajectory.tum" || rc=$?
+  python3 - "$work/loc_$path/report.json" "$path" "$rc" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 loc, ev, t = r["localization"], r.get("eval", {}), r["timings"]
 fix = loc.get("first_fix", {})
-out = {"path": sys.argv[2], "frames": r["frames"], "scans": loc["scans"],
+out = {"path": sys.argv[2], "exit_status": int(sys.argv[3]), "frames": r["frames"],
+       "scans": loc["scans"],
        "first_fix_s": fix.get("seconds_in"), "found_by": fix.get("found_by"),
        "localized_share_after_first_fix": loc.get("localized_share_after_first_fix"),
        "losses": loc["losses"],

@@ -45,6 +45,18 @@ inline pid_t spawn_featsense(const std::string& args, const std::filesystem::pat
   return pid;
 }
 
+/// Waits until `log` contains `what` (false: the child ended first, or 30 s passed).
+inline bool wait_for_line(const std::filesystem::path& log, const std::string& what, pid_t child) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < end) {
+    if (text_of(log).find(what) != std::string::npos) return true;
+    int status = 0;
+    if (waitpid(child, &status, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
 /// Waits until the store's journal holds a flushed chunk (false: the child ended first, or
 /// `timeout` passed).
 inline bool wait_for_first_flush(const std::filesystem::path& journal, pid_t child,

@@ -137,5 +137,51 @@ TEST(HtmlReport, ReadsAReportWithoutOptionalSections) {
   EXPECT_NE(html.find("</html>"), std::string::npos);
 }
 
+/// A report as `featsense localize` writes one.
+nlohmann::json localization_report() {
+  const nlohmann::json timing = {{"count", 90},    {"median_ms", 30.0}, {"p95_ms", 40.0},
+                                 {"max_ms", 50.0}, {"mean_ms", 31.0},   {"total_s", 2.8}};
+  const nlohmann::json spread = {{"median", 0.01}, {"p95", 0.02}, {"max", 0.03}, {"count", 90}};
+  nlohmann::json report;
+  report["input"] = {{"path", "drive.bag"}, {"format", "rosbag"}};
+  report["frames"] = 100;
+  report["localization"] = {
+      {"localized", true},
+      {"first_fix",
+       {{"scan", 7}, {"seconds_in", 0.7}, {"found_by", "descriptor"}, {"position", {1, 2, 3}}}},
+      {"localized_share_after_first_fix", 0.95},
+      {"scans", {{"localized", 88}, {"odometry", 5}, {"lost", 7}}},
+      {"fixes", 1},
+      {"losses", nlohmann::json::object()},
+      {"search", {{"keyframes", 4}, {"rejected", {{"awaiting <confirmation>", 1}}}}},
+      {"lost_periods", {{{"from_s", 3.0}, {"seconds", 0.5}, {"scans", 5}, {"found_again", true}}}},
+      {"events", {{{"scan", 7}, {"t_s", 0.7}, {"event", "localized at <here>"}}}},
+      {"plan", {{"file", "topdown.png"}}}};
+  report["eval"] = {{"localized", {{"translation_m", spread}, {"rotation_deg", spread}}},
+                    {"localized_over_0_5_m", 0}};
+  report["timings"] = {{"tracking", timing}, {"per_scan", timing}};
+  return report;
+}
+
+TEST(HtmlReport, ALocalizationRunShowsWhenItWasFoundAndHowWell) {
+  const fs::path folder = test::scratch_dir("html_report_localization");
+  write_file(folder / "topdown.png", "\x89PNG localized path");
+  const std::string html = html_report(localization_report(), folder);
+  EXPECT_NE(html.find("featsense localization report: drive.bag"), std::string::npos);
+  EXPECT_NE(html.find("after 0.7 s of the input (scan 7), by descriptor, at (1.0, 2.0, 3.0) m"),
+            std::string::npos);
+  EXPECT_NE(html.find("95.0 %"), std::string::npos);
+  EXPECT_NE(html.find("median 1 cm, p95 2 cm, max 3 cm (90 poses)"), std::string::npos);
+  EXPECT_NE(html.find("median 30 ms, p95 40 ms, max 50 ms (90 scans)"), std::string::npos);
+  EXPECT_NE(html.find("<h3>Lost after the first fix</h3>"), std::string::npos);
+  EXPECT_NE(html.find("localized at &lt;here&gt;"), std::string::npos);
+  EXPECT_NE(html.find("1 awaiting &lt;confirmation&gt;"), std::string::npos);
+  EXPECT_NE(html.find("Plan view with the localized path"), std::string::npos);
+  EXPECT_NE(html.find(base64_encode(std::string("\x89PNG localized path"))), std::string::npos);
+  // Not a mapping run's page: no pipeline stages, no loops.
+  EXPECT_EQ(html.find("Where the time went"), std::string::npos);
+  EXPECT_EQ(html.find("<h2>Loop closure</h2>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace featsense::viewer_export

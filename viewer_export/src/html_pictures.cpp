@@ -36,6 +36,11 @@ std::string pictures_section(const nlohmann::json& report, const fs::path& folde
   const Picture pictures[] = {
       {"Plan view", "The map from above, cut below its ceilings; the paths over it.",
        "/mesh/plan/file"},
+      {"Plan view with the localized path",
+       "The map around the path from above, cut below its ceilings: red where the sensor was "
+       "localized, amber where it went on odometry alone, gaps where it was lost; blue the "
+       "truth where one was given.",
+       "/localization/plan/file"},
       {"Mesh error",
        "The plan view coloured by each vertex's signed distance to the true surface: blue "
        "behind it, white on it, red in front.",

@@ -40,7 +40,9 @@ std::string raw_report_section(const nlohmann::json& report) {
 }  // namespace
 
 std::string html_report(const nlohmann::json& report, const std::filesystem::path& folder) {
-  std::string title = "featsense map report";
+  // A localization run's report (`featsense localize`) or a mapping run's.
+  const bool localization = json_at(report, {"localization"}) != nullptr;
+  std::string title = localization ? "featsense localization report" : "featsense map report";
   if (const nlohmann::json* input = json_at(report, {"input", "path"}))
     title += ": " + json_text(*input);
   std::string page = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
@@ -48,9 +50,14 @@ std::string html_report(const nlohmann::json& report, const std::filesystem::pat
   page += "<title>" + html_escape(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n";
   page += "<body>\n<h1>" + html_escape(title) + "</h1>\n";
   page += summary_section(report);
-  page += pictures_section(report, folder);
-  page += timing_section(report);
-  page += loops_section(report);
+  if (localization) {
+    page += localization_section(report);
+    page += pictures_section(report, folder);
+  } else {
+    page += pictures_section(report, folder);
+    page += timing_section(report);
+    page += loops_section(report);
+  }
   page += config_section(report);
   page += raw_report_section(report);
   page += "</body>\n</html>\n";

@@ -113,11 +113,25 @@ struct Localizer::State {
     // The odometry's frame starts at the belief: the session lies where the belief says.
     search_settings = relocalize;
     if (belief) search_settings.guess = Eigen::Isometry3d::Identity();
-    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
+    new_relocalizer();
     selector = std::make_unique<slam::loops::KeyframeSelector>(
         search_settings.loop.keyframe_distance_m, search_settings.loop.keyframe_angle_deg);
     last.reset();
     before_last.reset();
+  }
+
+  /// A fresh relocalizer, the counts of the last one kept.
+  void new_relocalizer() {
+    if (relocalizer) add_search_counts(relocalizer->counts(), counts);
+    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
+  }
+
+  static void add_search_counts(const slam::loops::RelocalizationCounts& from,
+                                LocalizerCounts& to) {
+    to.search_keyframes += from.keyframes;
+    to.search_candidates += from.candidates;
+    to.search_verified += from.verified;
+    for (const auto& [reason, n] : from.rejected) to.search_rejected[reason] += n;
   }
 
   /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to the map from
@@ -184,7 +198,7 @@ struct Localizer::State {
                   " % of the scan on it): searching on";
       // The relocalizer keeps a placement once made; a fresh one searches on, with the same
       // odometry.
-      relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
+      new_relocalizer();
       return out;
     }
     const Eigen::Isometry3d T = fit.result.T_target_source;
@@ -442,6 +456,7 @@ LocalizedScan Localizer::add_scan(const slam::Scan& scan) {
 
 LocalizerCounts Localizer::counts() const {
   LocalizerCounts out = state_->counts;
+  if (state_->relocalizer) State::add_search_counts(state_->relocalizer->counts(), out);
   const MapSurfaceCounts surface = state_->surface.counts();
   out.chunks_made = surface.chunks_made;
   out.chunks_reused = surface.chunks_reused;

@@ -166,24 +166,27 @@ Trajectory read_trajectory(const std::string& path, const std::string& format,
   return read_tum(path);
 }
 
+const char* const kTumHeader = "# timestamp tx ty tz qx qy qz qw\n";
+
+std::string tum_line(int64_t stamp_ns, const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  const Eigen::Vector3d t = T.translation();
+  const int64_t whole = stamp_ns / 1000000000;
+  const int64_t frac = stamp_ns % 1000000000;
+  char line[256];
+  std::snprintf(line, sizeof line, "%s%lld.%09lld %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
+                stamp_ns < 0 ? "-" : "", static_cast<long long>(std::llabs(whole)),
+                static_cast<long long>(std::llabs(frac)), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(),
+                q.w());
+  return line;
+}
+
 void write_tum(const Trajectory& trajectory, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw TrajectoryError(path + ": cannot write trajectory file");
-  out << "# timestamp tx ty tz qx qy qz qw\n";
-  char line[256];
-  for (size_t i = 0; i < trajectory.size(); ++i) {
-    const Eigen::Isometry3d& T = trajectory.poses[i];
-    const Eigen::Quaterniond q(T.linear());
-    const Eigen::Vector3d t = T.translation();
-    const int64_t ns = trajectory.stamps_ns[i];
-    const int64_t whole = ns / 1000000000;
-    const int64_t frac = ns % 1000000000;
-    std::snprintf(line, sizeof line, "%s%lld.%09lld %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
-                  ns < 0 ? "-" : "", static_cast<long long>(std::llabs(whole)),
-                  static_cast<long long>(std::llabs(frac)), t.x(), t.y(), t.z(), q.x(), q.y(),
-                  q.z(), q.w());
-    out << line;
-  }
+  out << kTumHeader;
+  for (size_t i = 0; i < trajectory.size(); ++i)
+    out << tum_line(trajectory.stamps_ns[i], trajectory.poses[i]);
   if (!out) throw TrajectoryError(path + ": write failed");
 }
 

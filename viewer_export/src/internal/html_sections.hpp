@@ -31,4 +31,8 @@ std::string timing_section(const nlohmann::json& report);
 /// The loop closure: counts, the loops closed, the candidates rejected and why.
 std::string loops_section(const nlohmann::json& report);
 
+/// A localization run's (`featsense localize`): the first fix, the share localized, the
+/// losses, the error against the truth, the time per scan, the lost periods and events.
+std::string localization_section(const nlohmann::json& report);
+
 }  // namespace featsense::viewer_export

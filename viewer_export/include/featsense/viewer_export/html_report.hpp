@@ -1,5 +1,5 @@
 #pragma once
-// report.html: a mapping run's report.json as one page that opens offline in any browser.
+// report.html: a mapping or localization run's report.json as one page that opens offline in any browser.
 // Everything is inside the file: pictures as base64 data URIs, charts as inline SVG, styles
 // inline; no scripts, no fonts, no addresses.
 

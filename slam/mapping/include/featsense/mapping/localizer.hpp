@@ -120,6 +120,12 @@ struct LocalizerCounts {
   std::vector<double> register_ms;
   size_t points_per_scan_sum = 0;
   std::vector<double> search_ms;  ///< per scan while lost
+  /// The search's keyframes matched against the map's, the candidates they had, those the
+  /// registration to the map keyframe verified, and why the others placed nothing.
+  size_t search_keyframes = 0;
+  size_t search_candidates = 0;
+  size_t search_verified = 0;
+  std::map<std::string, size_t> search_rejected;
   size_t map_keyframes = 0;
   size_t map_chunks = 0;
   /// The map's surface: chunks read, reused, the cache's bytes.

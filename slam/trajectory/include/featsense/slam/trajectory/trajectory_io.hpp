@@ -31,6 +31,11 @@ Trajectory read_trajectory(const std::string& path, const std::string& format = 
 
 /// Writes TUM (stamps in seconds with nanosecond digits). Throws TrajectoryError on failure.
 void write_tum(const Trajectory& trajectory, const std::string& path);
+
+/// The header line write_tum starts with, and one pose's line as it writes it (both ending
+/// in a newline): for files written a pose at a time.
+extern const char* const kTumHeader;
+std::string tum_line(int64_t stamp_ns, const Eigen::Isometry3d& T);
 /// Writes KITTI (12 numbers a line). Throws TrajectoryError on failure.
 void write_kitti(const Trajectory& trajectory, const std::string& path);
 
