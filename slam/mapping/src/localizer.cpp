@@ -157,10 +157,12 @@ struct Localizer::State {
     // Where the map saw too little of what the scan sees, the fit says nothing either way.
     const bool telling = fit.map.observed >= settings.min_observed_points;
     const bool enough = telling && fit.map.coverage >= settings.min_coverage;
-    // A registration still moving when its iterations ran out is not a fit, however well it
-    // fits where it stopped: it may be sliding along a street.
-    fit.good = enough && fit.result.converged &&
-               fit.map.inlier_fraction >= settings.min_inlier_fraction &&
+    // A pose the surface leaves free in some direction is no fit, however well it fits: it
+    // may be sliding along a street. One held firmly is, converged or not: the iterations
+    // that ran out were trading voxels by millimetres.
+    const bool held = fit.map.position_sigma_m <= settings.max_position_sigma_m &&
+                      fit.map.rotation_sigma_deg <= settings.max_rotation_sigma_deg;
+    fit.good = enough && held && fit.map.inlier_fraction >= settings.min_inlier_fraction &&
                fit.map.fitness_m <= settings.max_fitness_m;
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
   }
@@ -190,6 +192,8 @@ struct Localizer::State {
     out.fitness_m = fit.map.fitness_m;
     out.inlier_fraction = fit.map.inlier_fraction;
     out.coverage = fit.map.coverage;
+    out.position_sigma_m = fit.map.position_sigma_m;
+    out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
     out.iterations = fit.result.iterations;
     if (!fit.good) {
       ++counts.unconfirmed_matches;
@@ -296,23 +300,18 @@ struct Localizer::State {
     const auto register_start = Clock::now();
     // Registered at every voxel size from the prediction, deskewed with the predicted motion;
     // then deskewed again with the motion that found, and registered again at the finest.
-    // Where the second does not settle, the first stands.
     Fit fit;
     if (cloud.measured.size() >= kMinPoints) {
       const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
       const slam::refine::GaussianCloud first_cloud = deskewed(cloud, sweep_to(predicted));
       fit.points = first_cloud.size();
       fit.result = slam::refine::align(target->vgicp, first_cloud, predicted, settings.vgicp);
-      Fit again;
-      if (fit.result.converged) {
-        const Eigen::Isometry3d found = fit.result.T_target_source;
-        again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
-      }
-      if (again.result.converged) {
-        fit = std::move(again);
-      } else {
-        judge(*target, first_cloud, fit);
-      }
+      // Deskewed again with the motion found, and registered again from there; where that
+      // fits worse than the first (it went astray), the first stands.
+      const Eigen::Isometry3d found = fit.result.T_target_source;
+      Fit again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
+      judge(*target, first_cloud, fit);
+      if (again.good || !fit.good) fit = std::move(again);
     } else {
       fit.result.T_target_source = predicted;
     }
@@ -322,6 +321,8 @@ struct Localizer::State {
     out.fitness_m = fit.map.fitness_m;
     out.inlier_fraction = fit.map.inlier_fraction;
     out.coverage = fit.map.coverage;
+    out.position_sigma_m = fit.map.position_sigma_m;
+    out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
     out.iterations = fit.result.iterations;
     if (fit.good) {
       const Eigen::Isometry3d T = fit.result.T_target_source;

@@ -1,5 +1,9 @@
 #include "map_targets.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -24,6 +28,10 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
   MapFit fit;
   fit.points = cloud.size();
   double squares = 0.0;
+  // Each inlier's distance to its plane, as a function of a small motion of the sensor
+  // (rotation about the sensor, then translation): its row of the point-to-plane problem.
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  const Eigen::Vector3d sensor = T.translation();
   std::vector<const slam::refine::VoxelGaussian*> found;
   for (const Eigen::Vector3d& p : cloud.points) {
     const Eigen::Vector3d q = T * p;
@@ -38,12 +46,32 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
     if (std::abs(d) > inlier_distance_m) continue;
     ++fit.inliers;
     squares += d * d;
+    const Eigen::Vector3d& n = found.front()->normal;
+    Eigen::Matrix<double, 6, 1> row;
+    row << (q - sensor).cross(n), n;
+    information.selfadjointView<Eigen::Upper>().rankUpdate(row);
   }
   if (fit.observed > 0)
     fit.inlier_fraction = static_cast<double>(fit.inliers) / static_cast<double>(fit.observed);
   if (fit.points > 0)
     fit.coverage = static_cast<double>(fit.observed) / static_cast<double>(fit.points);
   if (fit.inliers > 0) fit.fitness_m = std::sqrt(squares / static_cast<double>(fit.inliers));
+  if (fit.inliers >= 6) {
+    const Eigen::Matrix<double, 6, 6> full = information.selfadjointView<Eigen::Upper>();
+    // The pose's covariance (fitness_m^2 per measurement); its largest spread per block.
+    Eigen::FullPivLU<Eigen::Matrix<double, 6, 6>> lu(full);
+    if (lu.isInvertible()) {
+      const Eigen::Matrix<double, 6, 6> covariance = lu.inverse() * fit.fitness_m * fit.fitness_m;
+      const auto largest = [](const Eigen::Matrix3d& block) {
+        return std::sqrt(std::max(
+            0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block, Eigen::EigenvaluesOnly)
+                     .eigenvalues()
+                     .maxCoeff()));
+      };
+      fit.rotation_sigma_deg = largest(covariance.topLeftCorner<3, 3>()) * 180.0 / M_PI;
+      fit.position_sigma_m = largest(covariance.bottomRightCorner<3, 3>());
+    }
+  }
   return fit;
 }
 

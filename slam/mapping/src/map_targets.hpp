@@ -10,6 +10,7 @@
 
 #include <condition_variable>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -43,6 +44,13 @@ struct MapFit {
   double inlier_fraction = 0.0;  ///< inliers / observed
   double coverage = 0.0;         ///< observed / points
   double fitness_m = 0.0;        ///< RMS distance of the inliers to the surface
+  /// How firmly the inliers hold the pose: the standard deviation of its position along the
+  /// direction they constrain least, and of its heading and tilt about the axis they
+  /// constrain least, from their distances to the surface's planes (each an independent
+  /// measurement of fitness_m's spread). Infinite where they leave a direction free (a
+  /// street's facades seen alone fix nothing along the street).
+  double position_sigma_m = std::numeric_limits<double>::infinity();
+  double rotation_sigma_deg = std::numeric_limits<double>::infinity();
 };
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
                        const Eigen::Isometry3d& T, double inlier_distance_m);

@@ -63,6 +63,14 @@ struct LocalizerSettings {
   /// can fit the little it saw well at a pose a few decimetres off.
   size_t min_observed_points = 50;
   double min_coverage = 0.25;
+  /// ... and its points on the surface must hold the pose this firmly (the standard deviation
+  /// along the direction, and about the axis, they constrain least: MapFit). A street's
+  /// facades alone leave the pose free along the street; a thinned OS1-128 scan in a street
+  /// the map knows holds it to 3-7 mm, one that sees a street the map only glimpsed to 3-6 cm.
+  /// A fit held this firmly stands also where the registration's last steps still traded
+  /// voxels (not converged within its iterations): it cannot slide.
+  double max_position_sigma_m = 0.015;
+  double max_rotation_sigma_deg = 0.1;
   /// Covariances of a scan's points from this many nearest.
   int neighbours = 10;
   /// Voxels of the map's surface observed at least this much (as its mesh's).
@@ -88,6 +96,10 @@ struct LocalizedScan {
   /// Of its points where the map observed anything, the share on the map's surface.
   double inlier_fraction = 0.0;
   double coverage = 0.0;  ///< the share of its points where the map observed anything
+  /// How firmly the points on the surface hold the pose: its standard deviation along the
+  /// direction (about the axis) they constrain least; infinite where they leave one free.
+  double position_sigma_m = 0.0;
+  double rotation_sigma_deg = 0.0;
   int iterations = 0;
   double ms = 0.0;  ///< add_scan's time
   /// What changed at this scan, for the log ("localized: ...", "lost: ..."); mostly empty.
