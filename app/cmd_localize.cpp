@@ -10,6 +10,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "featsense/bench/measurements.hpp"
 #include "featsense/mapping/localizer.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
 #include "json_output.hpp"
@@ -46,6 +47,9 @@ constexpr int kNeverLocalizedExit = 3;
 /// How much of the map around the path the plan view shows: enough for the streets and
 /// rooms beside it, not the whole map of a city.
 constexpr double kPlanMarginM = 15.0;
+
+/// Seconds of input between two readings of the resident memory.
+constexpr double kRssIntervalS = 30.0;
 
 std::string progress_text(const mapping::LocalizerCounts& counts) {
   const auto count = [&](const char* status) {
@@ -108,6 +112,10 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
     run.scans.push_back(localizer.add_scan(*scan));
     const mapping::LocalizedScan& done = run.scans.back();
     files.add(done);
+    // The memory every half minute of input: it must stay flat however long the run.
+    const double input_s = 1e-9 * static_cast<double>(done.stamp_ns - run.scans.front().stamp_ns);
+    if (run.rss_mb.empty() || input_s >= run.rss_mb.back().first + kRssIntervalS)
+      run.rss_mb.emplace_back(input_s, bench::current_rss_mb());
     if (!done.event.empty()) {
       progress.finish();
       spdlog::info("scan {}: {}", done.sequence, done.event);

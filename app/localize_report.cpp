@@ -118,6 +118,10 @@ nlohmann::json localize_report_json(const config::Config& config, const Localize
   report["recording_s"] = recording_s;
   report["real_time_factor"] = run.wall_s > 0.0 ? recording_s / run.wall_s : 0.0;
   report["peak_rss_mb"] = bench::peak_rss_mb();
+  nlohmann::json rss = nlohmann::json::array();
+  for (const auto& [seconds, mb] : run.rss_mb)
+    rss.push_back({{"input_s", seconds}, {"rss_mb", mb}});
+  report["rss_mb_over_input"] = rss;
 
   nlohmann::json& loc = report["localization"];
   loc["scans"] = {{"localized", 0}, {"odometry", 0}, {"lost", 0}};

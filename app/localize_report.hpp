@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "featsense/config/config.hpp"
@@ -26,6 +27,8 @@ struct LocalizeRun {
   double wall_s = 0.0;
   size_t frames_skipped = 0;
   size_t warnings = 0;
+  /// The resident memory as the input went on: (seconds of input, MiB), every half minute.
+  std::vector<std::pair<double, double>> rss_mb;
 };
 
 /// The report; with `truth` (poses in the map's frame) each posed scan's error too.

@@ -1,6 +1,7 @@
 // The localization part of report.html, for `featsense localize`'s report: when and where the
 // sensor was found, how much of the run it was localized, when it was lost and why, the error
 // against the truth where one was given, and the time per scan.
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -85,6 +86,20 @@ std::string summary_table(const nlohmann::json& loc) {
   return table(rows);
 }
 
+/// The resident memory as the input went on: where it began, where it ended, its peak.
+std::string memory_text(const nlohmann::json& samples) {
+  if (!samples.is_array() || samples.empty()) return "-";
+  double peak = 0.0;
+  for (const nlohmann::json& s : samples) peak = std::max(peak, s.value("rss_mb", 0.0));
+  const nlohmann::json& first = samples.front();
+  const nlohmann::json& last = samples.back();
+  char text[160];
+  std::snprintf(text, sizeof text, "%.0f MB at %.0f s of input, %.0f MB at %.0f s, at most %.0f MB",
+                first.value("rss_mb", 0.0), first.value("input_s", 0.0), last.value("rss_mb", 0.0),
+                last.value("input_s", 0.0), peak);
+  return text;
+}
+
 std::string spread_text(const nlohmann::json* spread, double scale, const char* unit) {
   if (!spread || !spread->is_object()) return "-";
   char text[160];
@@ -134,7 +149,9 @@ std::string timing_table(const nlohmann::json& report) {
   rows.emplace_back("searching (a scan while lost)", timing_text(json_at(*timings, {"search"})));
   rows.emplace_back("searching in all", text_at(*timings, {"search_total_s"}, " s"));
   rows.emplace_back("every scan", timing_text(json_at(*timings, {"per_scan"})));
-  return "<h3>Time per scan</h3>\n" + table(rows);
+  if (const nlohmann::json* memory = json_at(report, {"rss_mb_over_input"}))
+    rows.emplace_back("resident memory", memory_text(*memory));
+  return "<h3>Time per scan, and memory</h3>\n" + table(rows);
 }
 
 std::string lost_periods_table(const nlohmann::json& loc) {

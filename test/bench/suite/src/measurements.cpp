@@ -1,9 +1,11 @@
 #include "featsense/bench/measurements.hpp"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include "featsense/slam/trajectory/error_statistics.hpp"
 
@@ -41,6 +43,14 @@ double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+double current_rss_mb() {
+  // statm: the program's size and its resident part, in pages.
+  std::ifstream statm("/proc/self/statm");
+  double size_pages = 0.0, resident_pages = 0.0;
+  if (!(statm >> size_pages >> resident_pages)) return 0.0;
+  return resident_pages * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1048576.0;
 }
 
 }  // namespace featsense::bench

@@ -29,4 +29,7 @@ nlohmann::json min_median_max(const std::vector<double>& values);
 /// The process's peak resident memory so far, MiB.
 double peak_rss_mb();
 
+/// The process's resident memory now, MiB (0 where /proc cannot tell).
+double current_rss_mb();
+
 }  // namespace featsense::bench
