@@ -106,6 +106,56 @@ TEST(Relocalizer, AGuessOutsideTheMapPlacesNothing) {
   EXPECT_LT((placed->T_map_session.translation() - truth.front().translation()).norm(), 0.1);
 }
 
+TEST(Relocalizer, AVerifierChecksTheCandidatesInPlaceOfTheMapKeyframes) {
+  // A verifier (a localizer's registration to the map's surface) decides each candidate: here
+  // one that knows the truth, takes a guess within 6 m of it and gives the true place.
+  const mesh::TriangleMesh scene = build_scene("parking");
+  const std::vector<Eigen::Isometry3d> truth = westbound(50.0, 20.0);
+  size_t k = 0;
+  size_t calls = 0;
+  const PlaceVerifier knows_the_truth = [&](const Eigen::Isometry3d& guess,
+                                            const refine::GaussianCloud& cloud) {
+    ++calls;
+    EXPECT_GT(cloud.size(), 100u);
+    PlaceCheck check;
+    if ((guess.translation() - truth[k].translation()).norm() > 6.0) {
+      check.rejection = "elsewhere";
+      return check;
+    }
+    check.T_map_query = truth[k];
+    check.inlier_fraction = 0.8;
+    return check;
+  };
+  Relocalizer relocalizer(lane_map(scene, 0, eastbound(6.0, 58.0)), RelocalizeSettings{},
+                          knows_the_truth);
+  std::optional<Relocalization> placed;
+  for (k = 0; k < truth.size() && !placed; ++k) {
+    placed = relocalizer.add_keyframe(
+        static_cast<int64_t>(k) * 400'000'000, truth.front().inverse() * truth[k], 2.0 * k,
+        test::keyframe_scan_at(scene, truth[k], static_cast<uint32_t>(k)));
+  }
+  ASSERT_TRUE(placed);
+  EXPECT_EQ(calls, relocalizer.counts().candidates);  // every candidate, by the verifier
+  // The place is the verifier's, exactly.
+  EXPECT_LT((placed->T_map_session.translation() - truth.front().translation()).norm(), 1e-9);
+  EXPECT_DOUBLE_EQ(placed->inlier_fraction, 0.8);
+
+  // A verifier that finds nothing anywhere: nothing placed, its reason counted.
+  Relocalizer refuses(lane_map(scene, 0, eastbound(6.0, 58.0)), RelocalizeSettings{},
+                      [](const Eigen::Isometry3d&, const refine::GaussianCloud&) {
+                        PlaceCheck check;
+                        check.rejection = "no surface";
+                        return check;
+                      });
+  for (size_t j = 0; j < truth.size(); ++j) {
+    EXPECT_FALSE(refuses.add_keyframe(
+        static_cast<int64_t>(j) * 400'000'000, truth.front().inverse() * truth[j], 2.0 * j,
+        test::keyframe_scan_at(scene, truth[j], static_cast<uint32_t>(j))));
+  }
+  EXPECT_EQ(refuses.counts().verified, 0u);
+  EXPECT_EQ(refuses.counts().rejected.at("no surface"), refuses.counts().candidates);
+}
+
 TEST(SessionLinks, ALaterSessionPlacedOffIsPulledOntoTheFirst) {
   const mesh::TriangleMesh scene = build_scene("parking");
   std::vector<MapKeyframe> keyframes = lane_map(scene, 0, eastbound(6.0, 58.0));

@@ -40,8 +40,9 @@ RelocalizeSettings relocalize_from_config(const config::Config& config) {
   return settings;
 }
 
-Relocalizer::Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings)
-    : map_(std::move(map)), settings_(settings) {
+Relocalizer::Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings,
+                         PlaceVerifier verifier)
+    : map_(std::move(map)), settings_(settings), verifier_(std::move(verifier)) {
   map_poses_.reserve(map_.size());
   for (const MapKeyframe& keyframe : map_) map_poses_.push_back(keyframe.T_map_sensor);
 }
@@ -160,14 +161,32 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
   };
   std::vector<Verified> verified;
   for (const Candidate& candidate : found) {
-    const refine::GaussianCloud target = keyframe_target(map_, map_poses_, candidate.map_keyframe,
-                                                         loop.target_neighbours, loop.neighbours);
-    const refine::VgicpResult result = refine::align(target, cloud, candidate.guess, loop.vgicp);
-    if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
-      reject(to_string(*failed));
+    refine::VgicpResult result;
+    std::optional<Eigen::Isometry3d> placed;
+    if (verifier_) {
+      const PlaceCheck check =
+          verifier_(map_poses_[candidate.map_keyframe] * candidate.guess, cloud);
+      if (check.T_map_query) {
+        placed = check.T_map_query;
+        result.T_target_source = map_poses_[candidate.map_keyframe].inverse() * *placed;
+        result.converged = true;
+        result.fitness_m = check.fitness_m;
+        result.inlier_fraction = check.inlier_fraction;
+      } else {
+        reject(check.rejection.c_str());
+      }
     } else {
-      const Eigen::Isometry3d T_map_query =
-          map_poses_[candidate.map_keyframe] * result.T_target_source;
+      const refine::GaussianCloud target = keyframe_target(map_, map_poses_, candidate.map_keyframe,
+                                                           loop.target_neighbours, loop.neighbours);
+      result = refine::align(target, cloud, candidate.guess, loop.vgicp);
+      if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
+        reject(to_string(*failed));
+      } else {
+        placed = map_poses_[candidate.map_keyframe] * result.T_target_source;
+      }
+    }
+    if (placed) {
+      const Eigen::Isometry3d T_map_query = *placed;
       if (candidate.found_by == "guess" &&
           (T_map_query.translation() - (*settings_.guess * T_session_sensor).translation()).norm() >
               settings_.guess_radius_m) {

@@ -1,8 +1,10 @@
 #include "featsense/mapping/localizer.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <list>
 #include <stdexcept>
 #include <utility>
 
@@ -112,6 +114,8 @@ struct Localizer::State {
     T_map_odometry = Eigen::Isometry3d::Identity();
     // The odometry's frame starts at the belief: the session lies where the belief says.
     search_settings = relocalize;
+    search_settings.ring_candidates = settings.search_ring_candidates;
+    search_settings.verifications = settings.search_verifications;
     if (belief) search_settings.guess = Eigen::Isometry3d::Identity();
     new_relocalizer();
     selector = std::make_unique<slam::loops::KeyframeSelector>(
@@ -120,10 +124,78 @@ struct Localizer::State {
     before_last.reset();
   }
 
-  /// A fresh relocalizer, the counts of the last one kept.
+  /// A fresh relocalizer, the counts of the last one kept. Its candidates are checked against
+  /// the map's surface: a map keyframe's cloud is one thinned scan from one lane, and a sensor
+  /// a lane over, or driving the other way, sees too much of it otherwise to fit it.
   void new_relocalizer() {
     if (relocalizer) add_search_counts(relocalizer->counts(), counts);
-    relocalizer = std::make_unique<slam::loops::Relocalizer>(saved.keyframes, search_settings);
+    relocalizer = std::make_unique<slam::loops::Relocalizer>(
+        saved.keyframes, search_settings,
+        [this](const Eigen::Isometry3d& guess, const slam::refine::GaussianCloud& cloud) {
+          return check_place(guess, cloud);
+        });
+  }
+
+  /// The surface around `position` for checking places: kept for the next keyframes, which
+  /// propose the same places.
+  std::shared_ptr<const MapTarget> search_target(const Eigen::Vector3d& position) {
+    const double cell_m = 0.25 * settings.search_radius_m;
+    const std::array<int64_t, 2> key = {static_cast<int64_t>(std::floor(position.x() / cell_m)),
+                                        static_cast<int64_t>(std::floor(position.y() / cell_m))};
+    for (auto it = search_targets.begin(); it != search_targets.end(); ++it) {
+      if (it->first != key) continue;
+      std::shared_ptr<const MapTarget> target = it->second;
+      search_targets.erase(it);
+      search_targets.emplace_front(key, target);
+      return target;
+    }
+    const Eigen::Vector3d centre((key[0] + 0.5) * cell_m, (key[1] + 0.5) * cell_m, position.z());
+    std::shared_ptr<const MapTarget> target = build_map_target(
+        surface, centre, settings.search_radius_m + cell_m, settings.search_voxel_sizes_m,
+        settings.vgicp.fitness_voxel_m, settings.vgicp.fitness_voxel_m);
+    search_targets.emplace_front(key, target);
+    if (search_targets.size() > settings.search_targets_kept) search_targets.pop_back();
+    return target;
+  }
+
+  /// A candidate place of a search keyframe: registered to the map's surface from `guess`
+  /// and judged as a tracked scan is.
+  slam::loops::PlaceCheck check_place(const Eigen::Isometry3d& guess,
+                                      const slam::refine::GaussianCloud& cloud) {
+    slam::loops::PlaceCheck check;
+    if (cloud.size() < kMinPoints) {
+      check.rejection = "too few points";
+      return check;
+    }
+    const std::shared_ptr<const MapTarget> target = search_target(guess.translation());
+    slam::refine::VgicpSettings vgicp = settings.vgicp;
+    vgicp.voxel_sizes_m = settings.search_voxel_sizes_m;
+    const auto fit_from = [&](const Eigen::Isometry3d& from) {
+      Fit fit;
+      fit.points = cloud.size();
+      fit.result = slam::refine::align(target->vgicp, cloud, from, vgicp);
+      judge(*target, cloud, fit);
+      return fit;
+    };
+    Fit fit = fit_from(guess);
+    if (!fit.good) {
+      // A street or a corridor looks much the same both ways: the descriptor's heading may be
+      // the map keyframe's where the sensor faces the other way.
+      const Eigen::Isometry3d turned = guess * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ());
+      Fit other = fit_from(turned);
+      if (other.good || other.map.inlier_fraction > fit.map.inlier_fraction) fit = std::move(other);
+    }
+    check.fitness_m = fit.map.fitness_m;
+    check.inlier_fraction = fit.map.inlier_fraction;
+    if (fit.good) {
+      check.T_map_query = fit.result.T_target_source;
+    } else {
+      check.rejection = fit.map.coverage < settings.min_coverage ? "surface: little of it mapped"
+                        : fit.map.inlier_fraction < settings.min_inlier_fraction
+                            ? "surface: inliers"
+                            : "surface: fit";
+    }
+    return check;
   }
 
   static void add_search_counts(const slam::loops::RelocalizationCounts& from,
@@ -383,6 +455,8 @@ struct Localizer::State {
   std::unique_ptr<slam::odometry::OdometryLocator> odometry;
   Eigen::Isometry3d T_map_odometry = Eigen::Isometry3d::Identity();
   std::unique_ptr<slam::loops::Relocalizer> relocalizer;
+  /// Targets of the places the search checked, the latest first.
+  std::list<std::pair<std::array<int64_t, 2>, std::shared_ptr<const MapTarget>>> search_targets;
   std::unique_ptr<slam::loops::KeyframeSelector> selector;
   /// The current search's settings: relocalize.*, with the guess where it has a belief.
   slam::loops::RelocalizeSettings search_settings;

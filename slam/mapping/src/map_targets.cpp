@@ -92,14 +92,16 @@ MapTargets::~MapTargets() {
   thread_.join();
 }
 
-std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre) {
-  const auto start = std::chrono::steady_clock::now();
-  const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m_);
+std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
+                                                  const Eigen::Vector3d& centre, double radius_m,
+                                                  const std::vector<double>& voxel_sizes_m,
+                                                  double fitness_voxel_m, double block_m) {
+  const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m);
   const std::vector<std::shared_ptr<const ChunkSurface>> surfaces =
-      surface_.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
+      surface.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
   std::vector<slam::refine::VoxelGaussian> parts;
   std::unordered_set<uint64_t> observed;
-  const double radius2 = radius_m_ * radius_m_;
+  const double radius2 = radius_m * radius_m;
   for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces) {
     for (const SurfaceCell& cell : chunk->cells) {
       if ((cell.mean.cast<double>() - centre).head<2>().squaredNorm() > radius2) continue;
@@ -109,13 +111,19 @@ std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre
       observed.insert(grid_key(block));
   }
   std::vector<slam::refine::VoxelGaussians> levels;
-  for (const double voxel_m : vgicp_.voxel_sizes_m) levels.emplace_back(parts, voxel_m);
-  slam::refine::VoxelGaussians fitness(parts, vgicp_.fitness_voxel_m);
+  for (const double voxel_m : voxel_sizes_m) levels.emplace_back(parts, voxel_m);
+  slam::refine::VoxelGaussians fitness(parts, fitness_voxel_m);
   auto made = std::make_shared<MapTarget>(
       centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
   made->observed = std::move(observed);
-  made->block_m = block_m_;
-  std::shared_ptr<const MapTarget> target = std::move(made);
+  made->block_m = block_m;
+  return made;
+}
+
+std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre) {
+  const auto start = std::chrono::steady_clock::now();
+  std::shared_ptr<const MapTarget> target = build_map_target(
+      surface_, centre, radius_m_, vgicp_.voxel_sizes_m, vgicp_.fitness_voxel_m, block_m_);
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.built;
   counts_.build_ms += ms_since(start);

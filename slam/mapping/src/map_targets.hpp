@@ -17,6 +17,7 @@
 #include <thread>
 #include <unordered_set>
 #include <utility>
+#include <vector>
 
 #include "featsense/slam/refine/vgicp.hpp"
 #include "map_surface.hpp"
@@ -54,6 +55,14 @@ struct MapFit {
 };
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
                        const Eigen::Isometry3d& T, double inlier_distance_m);
+
+/// The target of the surface within `radius_m` (horizontally) of `centre`, with voxels of
+/// `voxel_sizes_m` (multiples of the surface's cells) and the fit's voxels of `fitness_voxel_m`,
+/// the observed blocks of `block_m`. Reads what the surface has not cached.
+std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
+                                                  const Eigen::Vector3d& centre, double radius_m,
+                                                  const std::vector<double>& voxel_sizes_m,
+                                                  double fitness_voxel_m, double block_m);
 
 struct MapTargetCounts {
   size_t built = 0;

@@ -77,6 +77,18 @@ struct LocalizerSettings {
   double min_weight = 0.5;
   /// Fits in a row after which the odometry stops and constant velocity predicts.
   size_t settle_scans = 5;
+  /// The search: each place a keyframe's descriptor proposes is checked by registering the
+  /// keyframe to the map's surface within this radius of it, from the coarsest of these
+  /// voxels (the guess is the map keyframe's place: metres off where the sensor drives in
+  /// another lane or walks the sidewalk; the finest need not be the tracking's to tell the
+  /// place), and judged as a tracked scan is. The descriptors of a town's crossings and
+  /// streets are much alike: more candidates are checked than `map --continue` checks.
+  double search_radius_m = 30.0;
+  std::vector<double> search_voxel_sizes_m = {2.0, 1.0, 0.5};
+  /// Targets of places checked kept for the next keyframes' candidates (the same places).
+  size_t search_targets_kept = 8;
+  size_t search_ring_candidates = 50;
+  size_t search_verifications = 8;
 
   static slam::refine::VgicpSettings tracking_vgicp();
 };

@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -71,10 +72,25 @@ struct Relocalization {
   size_t agreeing = 0;  ///< keyframes that agreed on it, this one included
 };
 
+/// A candidate place checked by the caller's own registration in place of the map keyframe's
+/// cloud (a localizer's, to the map's surface): the place found and the share of the points
+/// on the map there, or why it is not the place.
+struct PlaceCheck {
+  std::optional<Eigen::Isometry3d> T_map_query;
+  double fitness_m = 0.0;
+  double inlier_fraction = 0.0;
+  std::string rejection;  ///< where there is no place
+};
+/// From the guess of the query keyframe's pose in the map and its points (sensor frame).
+using PlaceVerifier = std::function<PlaceCheck(const Eigen::Isometry3d& T_map_query_guess,
+                                               const refine::GaussianCloud& cloud)>;
+
 class Relocalizer {
  public:
-  /// `map` sorted by (session, index), each keyframe's travelled_m filled.
-  Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings);
+  /// `map` sorted by (session, index), each keyframe's travelled_m filled. `verifier`, where
+  /// given, checks each candidate in place of the registration to the map keyframe's cloud.
+  Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings,
+              PlaceVerifier verifier = {});
 
   /// The next keyframe of the new session: its stamp, its front-end pose in the session's
   /// frame, how far along the session's path, its points in the sensor frame (deskewed,
@@ -107,6 +123,7 @@ class Relocalizer {
   std::vector<MapKeyframe> map_;
   std::vector<Eigen::Isometry3d> map_poses_;
   RelocalizeSettings settings_;
+  PlaceVerifier verifier_;
   std::vector<Hypothesis> hypotheses_;
   std::optional<Relocalization> placement_;
   RelocalizationCounts counts_;
