@@ -3,15 +3,15 @@
 # map's frame is the simulation's, the run starting from the true first pose), then recordings
 # the map never saw localized in it with their truth beside them.
 #
-#   localize_town.sh WORK [PATH ...]     (default: drive walk kidnap drive-changed walk-changed)
+#   localize_town.sh WORK [PATH ...]   (default: drive walk kidnap drive-changed walk-changed lab)
 #
 # kidnap is the drive with its scans 400-659 cut out (splice_recording.py): between two sweeps
 # the sensor is 114 m away, on another street. drive-changed and walk-changed are the drive
 # and the walk through the town on another day (--scene town-changed: the parked cars moved).
-# lab is the lab walk (another place, an indoor room): it must never be found.
+# lab is the lab walk (another place, an indoor room): it must never be found (exit status 3).
 #
 # WORK/town_loop, WORK/loop_map (featsense simulate --scene town --path loop --seed 4; featsense
-# map --no-mesh: about 30 min on 2 cores) and WORK/town_PATH (featsense simulate --path PATH)
+# map --no-mesh: 5 to 30 min on 2 cores) and WORK/town_PATH (featsense simulate --path PATH)
 # are made where missing. Each run writes WORK/loc_PATH/ (trajectory.tum, localization.csv,
 # report.json with eval against the truth) and WORK/loc_PATH.time.txt (/usr/bin/time -v), and
 # prints one JSON line: the first fix, the scans by status, the errors of the localized poses,
@@ -20,7 +20,7 @@ set -euo pipefail
 work=$1
 shift
 paths=("$@")
-[ ${#paths[@]} -gt 0 ] || paths=(drive walk kidnap drive-changed walk-changed)
+[ ${#paths[@]} -gt 0 ] || paths=(drive walk kidnap drive-changed walk-changed lab)
 featsense=${FEATSENSE:-build/app/featsense}
 mkdir -p "$work"
 [ -d "$work/town_loop" ] ||
@@ -37,7 +37,8 @@ for path in "${paths[@]}"; do
     [ -d "$work/town_drive" ] ||
       "$featsense" simulate --quiet --scene town --path drive --seed 8 -o "$work/town_drive"
     [ -d "$work/town_kidnap" ] ||
-      python3 "$here/splice_recording.py" "$work/town_drive" "$work/town_kidnap" 0:399 660:901
+      python3 "$here/splice_recording.py" "$work/town_kidnap" "$work/town_drive:0:399" \
+        "$work/town_drive:660:901"
   fi
   if [ "$path" = lab ]; then
     [ -d "$work/town_lab" ] ||
