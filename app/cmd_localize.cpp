@@ -104,8 +104,19 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
   run.map = options.map;
   run.input = source->info();
   const auto start = std::chrono::steady_clock::now();
+  const bool live = !options.live.sensor.empty();
+  const std::string no_scan = run.input.path +
+                              ": no scan came before the stop (is the sensor sending there? see "
+                              "--host, --lidar-port)";
   while (!stop_signal.requested()) {
-    std::optional<slam::Scan> scan = source->next();
+    std::optional<slam::Scan> scan;
+    try {
+      scan = source->next();
+    } catch (const std::runtime_error&) {
+      // A live source stopped before its first packet says it had none: say where from.
+      if (live && stop_signal.requested() && run.scans.empty()) throw slam::InputError(no_scan);
+      throw;
+    }
     if (!scan) break;
     if (options.start && scan->sequence < *options.start) continue;
     if (options.end && scan->sequence > *options.end) break;
@@ -144,7 +155,12 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
                 progress_text(run.counts).c_str(), kReportHtml, folder.string().c_str());
   }
   // Ctrl+C is how a live run ends; a recording stopped early says so.
-  const bool live = !options.live.sensor.empty();
+  if (run.scans.empty()) {
+    throw slam::InputError(live ? no_scan
+                                : run.input.path +
+                                      ": no scan to localize (--start and --end "
+                                      "leave none)");
+  }
   if (run.interrupted && !live) throw Interrupted("localization stopped; what was done is written");
   if (!run.counts.first_fix) {
     throw CommandFailed(

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -193,6 +194,26 @@ TEST_F(CliLocalize, ASensorOnTheNetworkIsFoundAndTracked) {
             found["scans"]["localized"].get<size_t>() + found["scans"]["odometry"].get<size_t>());
 }
 
+TEST_F(CliLocalize, CtrlCBeforeTheSensorSentAnythingIsOneClearMessage) {
+  const fs::path dir = scratch_dir("cli_localize_live_silent");
+  CommandResult run = run_featsense(
+      "simulate --quiet --scene lab --frames 1 --format ouster-pcap -o " + (dir / "s").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const fs::path log = dir / "localize.log";
+  const pid_t localize = spawn_featsense(
+      "localize " + map().string() + " --sensor ouster --meta " +
+          (dir / "s" / "recording.json").string() + " --host 127.0.0.1 --lidar-port " +
+          std::to_string(free_udp_port()) + " --imu-port " + std::to_string(free_udp_port()) +
+          " -o " + (dir / "out").string(),
+      log);
+  ASSERT_TRUE(wait_for_line(log, "listening on", localize)) << text_of(log);
+  kill(localize, SIGINT);
+  // Nothing was sent: said so, not "never found in the map", not a hang.
+  EXPECT_EQ(wait_exit_code(localize), 1);
+  EXPECT_NE(text_of(log).find("no scan came before the stop"), std::string::npos) << text_of(log);
+  EXPECT_EQ(text_of(log).find("never found"), std::string::npos) << text_of(log);
+}
+
 TEST_F(CliLocalize, ARecordingOrASensorNotBothNorNeither) {
   const fs::path out = scratch_dir("cli_localize_inputs");
   CommandResult run = run_featsense("localize " + map().string() + " " + input("drone").string() +
@@ -202,6 +223,11 @@ TEST_F(CliLocalize, ARecordingOrASensorNotBothNorNeither) {
   run = run_featsense("localize " + map().string() + " -o " + out.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("nothing to localize"), std::string::npos) << run.output;
+  // A range that leaves no scan.
+  run = run_featsense("localize " + map().string() + " " + input("drone").string() +
+                      " --start 500 -o " + out.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("no scan to localize"), std::string::npos) << run.output;
 }
 
 TEST_F(CliLocalize, ARecordingOfAnotherPlaceIsNeverFound) {
