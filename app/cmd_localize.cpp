@@ -197,7 +197,8 @@ Command register_localize(CLI::App& app, const CliContext& context) {
       "sensor's (or --sensor-address)");
   command
       ->add_option("-o,--output", options->output,
-                   "Folder for trajectory.tum, localization.csv and report.json")
+                   "Folder for trajectory.tum, localization.csv (both written as the scans come), "
+                   "report.json, report.html and topdown.png")
       ->required();
   command->add_option("--initial-pose", options->initial_pose,
                       "x,y,z,yaw_deg: where the first scan is believed to be in the map; "
