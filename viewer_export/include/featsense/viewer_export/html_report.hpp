@@ -1,7 +1,7 @@
 #pragma once
-// report.html: a mapping or localization run's report.json as one page that opens offline in any browser.
-// Everything is inside the file: pictures as base64 data URIs, charts as inline SVG, styles
-// inline; no scripts, no fonts, no addresses.
+// report.html: a mapping or localization run's report.json as one page that opens offline in any
+// browser. Everything is inside the file: pictures as base64 data URIs, charts as inline SVG,
+// styles inline; no scripts, no fonts, no addresses.
 
 #include <nlohmann/json.hpp>
 
