@@ -168,21 +168,12 @@ struct Localizer::State {
       return check;
     }
     const std::shared_ptr<const MapTarget> target = search_target(guess.translation());
-    slam::refine::VgicpSettings vgicp = settings.vgicp;
-    vgicp.voxel_sizes_m = settings.search_voxel_sizes_m;
-    const auto fit_from = [&](const Eigen::Isometry3d& from) {
-      Fit fit;
-      fit.points = cloud.size();
-      fit.result = slam::refine::align(target->vgicp, cloud, from, vgicp);
-      judge(*target, cloud, fit);
-      return fit;
-    };
-    Fit fit = fit_from(guess);
+    Fit fit = fit_on(*target, cloud, guess, false);
     if (!fit.good) {
       // A street or a corridor looks much the same both ways: the descriptor's heading may be
       // the map keyframe's where the sensor faces the other way.
       const Eigen::Isometry3d turned = guess * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ());
-      Fit other = fit_from(turned);
+      Fit other = fit_on(*target, cloud, turned, false);
       if (other.good || other.map.inlier_fraction > fit.map.inlier_fraction) fit = std::move(other);
     }
     check.fitness_m = fit.map.fitness_m;
@@ -206,19 +197,16 @@ struct Localizer::State {
     for (const auto& [reason, n] : from.rejected) to.search_rejected[reason] += n;
   }
 
-  /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to the map from
-  /// `guess`: at every voxel size, or at the finest alone.
-  Fit fit_to_map(const slam::refine::GaussianCloud& cloud, const Eigen::Isometry3d& guess,
-                 bool finest_only) {
+  /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to `target` from
+  /// `guess`, at each of its voxel sizes or at the finest alone, and judged.
+  Fit fit_on(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
+             const Eigen::Isometry3d& guess, bool finest_only) const {
     Fit fit;
     fit.points = cloud.size();
-    fit.result.T_target_source = guess;
-    if (cloud.size() < kMinPoints) return fit;
-    const std::shared_ptr<const MapTarget> target = targets.around(guess.translation());
-    fit.result = finest_only ? slam::refine::align_to_voxels(target->vgicp.levels.back(), cloud,
+    fit.result = finest_only ? slam::refine::align_to_voxels(target.vgicp.levels.back(), cloud,
                                                              guess, settings.vgicp)
-                             : slam::refine::align(target->vgicp, cloud, guess, settings.vgicp);
-    judge(*target, cloud, fit);
+                             : slam::refine::align(target.vgicp, cloud, guess, settings.vgicp);
+    judge(target, cloud, fit);
     return fit;
   }
 
@@ -257,9 +245,13 @@ struct Localizer::State {
     if (!found) return out;
     // The session's frame here is the odometry's, which starts at the belief.
     const Eigen::Isometry3d guess = found->T_map_session * placed->T_map_sensor;
-    const Fit fit = fit_to_map(
-        slam::refine::refinement_cloud(scan, *placed, settings.voxel_m, settings.neighbours), guess,
-        false);
+    const slam::refine::GaussianCloud cloud =
+        slam::refine::refinement_cloud(scan, *placed, settings.voxel_m, settings.neighbours);
+    Fit fit;
+    fit.points = cloud.size();
+    fit.result.T_target_source = guess;
+    if (cloud.size() >= kMinPoints)
+      fit = fit_on(*targets.around(guess.translation()), cloud, guess, false);
     out.registered = true;
     out.fitness_m = fit.map.fitness_m;
     out.inlier_fraction = fit.map.inlier_fraction;
@@ -375,14 +367,11 @@ struct Localizer::State {
     Fit fit;
     if (cloud.measured.size() >= kMinPoints) {
       const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
-      const slam::refine::GaussianCloud first_cloud = deskewed(cloud, sweep_to(predicted));
-      fit.points = first_cloud.size();
-      fit.result = slam::refine::align(target->vgicp, first_cloud, predicted, settings.vgicp);
+      fit = fit_on(*target, deskewed(cloud, sweep_to(predicted)), predicted, false);
       // Deskewed again with the motion found, and registered again from there; where that
       // fits worse than the first (it went astray), the first stands.
       const Eigen::Isometry3d found = fit.result.T_target_source;
-      Fit again = fit_to_map(deskewed(cloud, sweep_to(found)), found, true);
-      judge(*target, first_cloud, fit);
+      Fit again = fit_on(*target, deskewed(cloud, sweep_to(found)), found, true);
       if (again.good || !fit.good) fit = std::move(again);
     } else {
       fit.result.T_target_source = predicted;
