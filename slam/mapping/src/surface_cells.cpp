@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "featsense/slam/refine/voxel_key.hpp"
 #include "featsense/tsdf/voxel.hpp"
 
 namespace featsense::mapping {
@@ -61,9 +62,7 @@ class ChunkField {
 }  // namespace
 
 uint64_t grid_key(const std::array<int32_t, 3>& i) {
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  return ((static_cast<uint64_t>(i[0]) & mask) << 42) |
-         ((static_cast<uint64_t>(i[1]) & mask) << 21) | (static_cast<uint64_t>(i[2]) & mask);
+  return slam::refine::voxel_key(i[0], i[1], i[2]);
 }
 
 size_t ChunkSurface::bytes() const {

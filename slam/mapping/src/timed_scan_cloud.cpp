@@ -6,19 +6,9 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "featsense/slam/refine/voxel_key.hpp"
+
 namespace featsense::mapping {
-namespace {
-
-/// 21 bits per axis: unique within +/- 2^20 voxels of the sensor.
-uint64_t voxel_of(const Eigen::Vector3f& p, float inverse_voxel) {
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  const auto axis = [&](float v) {
-    return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v * inverse_voxel))) & mask;
-  };
-  return (axis(p.x()) << 42) | (axis(p.y()) << 21) | axis(p.z());
-}
-
-}  // namespace
 
 TimedScanCloud timed_scan_cloud(const slam::Scan& scan, double voxel_m, int neighbours,
                                 size_t max_points) {
@@ -34,7 +24,7 @@ TimedScanCloud timed_scan_cloud(const slam::Scan& scan, double voxel_m, int neig
   const bool timed = scan.time_offset_s.size() == scan.size();
   for (size_t i = 0; i < scan.size(); ++i) {
     if (!scan.valid[i] || !scan.xyz[i].allFinite()) continue;
-    Sum& sum = voxels[voxel_of(scan.xyz[i], inverse_voxel)];
+    Sum& sum = voxels[slam::refine::voxel_key_of(scan.xyz[i], inverse_voxel)];
     sum.point += scan.xyz[i].cast<double>();
     if (timed) sum.time_s += scan.time_offset_s[i];
     ++sum.count;

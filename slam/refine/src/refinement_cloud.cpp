@@ -6,19 +6,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "featsense/slam/refine/voxel_key.hpp"
+
 namespace featsense::slam::refine {
-namespace {
-
-/// 21 bits per axis: unique within +/- 2^20 voxels of the origin.
-uint64_t voxel_of(const Eigen::Vector3d& p, double inverse_voxel) {
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  const auto axis = [&](double v) {
-    return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v * inverse_voxel))) & mask;
-  };
-  return (axis(p.x()) << 42) | (axis(p.y()) << 21) | axis(p.z());
-}
-
-}  // namespace
 
 std::vector<Eigen::Vector3f> voxel_centroids(const Scan& scan, const ScanPlacement& placement,
                                              double voxel_m) {
@@ -46,7 +36,7 @@ std::vector<Eigen::Vector3f> voxel_centroids(const Scan& scan, const ScanPlaceme
       if (!scan.valid[i] || !scan.xyz[i].allFinite()) continue;
       Eigen::Vector3d p = scan.xyz[i].cast<double>();
       if (deskew) p = T_stamp_column[static_cast<size_t>(col)] * p;
-      Sum& sum = voxels[voxel_of(p, inverse_voxel)];
+      Sum& sum = voxels[voxel_key_of(p, inverse_voxel)];
       sum.point += p;
       ++sum.count;
     }

@@ -5,25 +5,17 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "featsense/slam/refine/voxel_key.hpp"
+
 namespace featsense::slam::refine {
-namespace {
-
-/// 21 bits per axis: unique within +/- 2^20 voxels of the origin.
-uint64_t key_of(int64_t x, int64_t y, int64_t z) {
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  return ((static_cast<uint64_t>(x) & mask) << 42) | ((static_cast<uint64_t>(y) & mask) << 21) |
-         (static_cast<uint64_t>(z) & mask);
-}
-
-}  // namespace
 
 VoxelGaussians::VoxelGaussians(const GaussianCloud& cloud, double voxel_m) : voxel_m_(voxel_m) {
   if (!(voxel_m > 0.0)) throw std::invalid_argument("VoxelGaussians: the voxel must be > 0");
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d& p = cloud.points[i];
-    const uint64_t key = key_of(static_cast<int64_t>(std::floor(p.x() / voxel_m)),
-                                static_cast<int64_t>(std::floor(p.y() / voxel_m)),
-                                static_cast<int64_t>(std::floor(p.z() / voxel_m)));
+    const uint64_t key = voxel_key(static_cast<int64_t>(std::floor(p.x() / voxel_m)),
+                                   static_cast<int64_t>(std::floor(p.y() / voxel_m)),
+                                   static_cast<int64_t>(std::floor(p.z() / voxel_m)));
     VoxelGaussian& v = voxels_[key];
     v.mean += p;
     v.covariance += cloud.covariances[i];
@@ -38,9 +30,9 @@ VoxelGaussians::VoxelGaussians(const std::vector<VoxelGaussian>& parts, double v
   for (const VoxelGaussian& part : parts) {
     if (part.points <= 0) continue;
     const Eigen::Vector3d& p = part.mean;
-    const uint64_t key = key_of(static_cast<int64_t>(std::floor(p.x() / voxel_m)),
-                                static_cast<int64_t>(std::floor(p.y() / voxel_m)),
-                                static_cast<int64_t>(std::floor(p.z() / voxel_m)));
+    const uint64_t key = voxel_key(static_cast<int64_t>(std::floor(p.x() / voxel_m)),
+                                   static_cast<int64_t>(std::floor(p.y() / voxel_m)),
+                                   static_cast<int64_t>(std::floor(p.z() / voxel_m)));
     VoxelGaussian& v = voxels_[key];
     v.mean += part.points * part.mean;
     v.covariance += part.points * part.covariance;
@@ -62,9 +54,9 @@ void VoxelGaussians::finish() {
 void VoxelGaussians::near(const Eigen::Vector3d& p,
                           std::vector<const VoxelGaussian*>& found) const {
   found.clear();
-  const auto it = voxels_.find(key_of(static_cast<int64_t>(std::floor(p.x() / voxel_m_)),
-                                      static_cast<int64_t>(std::floor(p.y() / voxel_m_)),
-                                      static_cast<int64_t>(std::floor(p.z() / voxel_m_))));
+  const auto it = voxels_.find(voxel_key(static_cast<int64_t>(std::floor(p.x() / voxel_m_)),
+                                         static_cast<int64_t>(std::floor(p.y() / voxel_m_)),
+                                         static_cast<int64_t>(std::floor(p.z() / voxel_m_))));
   if (it != voxels_.end()) found.push_back(&it->second);
 }
 
