@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,10 +52,11 @@ constexpr double kPlanMarginM = 15.0;
 /// Seconds of input between two readings of the resident memory.
 constexpr double kRssIntervalS = 30.0;
 
-std::string progress_text(const mapping::LocalizerCounts& counts) {
+/// "12 localized, 3 on odometry, 40 lost" of scans counted by status.
+std::string progress_text(const std::map<std::string, size_t>& by_status) {
   const auto count = [&](const char* status) {
-    const auto it = counts.by_status.find(status);
-    return it == counts.by_status.end() ? size_t{0} : it->second;
+    const auto it = by_status.find(status);
+    return it == by_status.end() ? size_t{0} : it->second;
   };
   return std::to_string(count("localized")) + " localized, " + std::to_string(count("odometry")) +
          " on odometry, " + std::to_string(count("lost")) + " lost";
@@ -66,7 +68,7 @@ void log_summary(const LocalizeRun& run) {
   const double seconds_in =
       1e-9 * static_cast<double>(c.first_fix->stamp_ns - run.scans.front().stamp_ns);
   spdlog::info("found after {:.1f} s of the recording ({} scans); {}", seconds_in,
-               c.first_fix->scan, progress_text(c));
+               c.first_fix->scan, progress_text(c.by_status));
 }
 
 std::unique_ptr<slam::ScanSource> open_input(LocalizeOptions& options, const config::Config& config,
@@ -104,6 +106,7 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
   run.map = options.map;
   run.input = source->info();
   const auto start = std::chrono::steady_clock::now();
+  std::map<std::string, size_t> by_status;
   const bool live = !options.live.sensor.empty();
   const std::string no_scan = run.input.path +
                               ": no scan came before the stop (is the sensor sending there? see "
@@ -131,7 +134,9 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
       progress.finish();
       spdlog::info("scan {}: {}", done.sequence, done.event);
     }
-    progress.update(run.scans.size(), progress_text(localizer.counts()));
+    // Counted here: the localizer's counts() copies every timing of the run so far.
+    ++by_status[mapping::to_string(done.status)];
+    progress.update(run.scans.size(), progress_text(by_status));
   }
   progress.finish();
   run.interrupted = stop_signal.requested();
@@ -152,7 +157,7 @@ void run_localize(LocalizeOptions& options, const CliContext& context) {
   if (!context.quiet) {
     std::printf("%s: %zu scans, %s; trajectory.tum, localization.csv, report.json, %s in %s\n",
                 run.counts.first_fix ? "localized" : "not localized", run.scans.size(),
-                progress_text(run.counts).c_str(), kReportHtml, folder.string().c_str());
+                progress_text(run.counts.by_status).c_str(), kReportHtml, folder.string().c_str());
   }
   // Ctrl+C is how a live run ends; a recording stopped early says so.
   if (run.scans.empty()) {
