@@ -13,8 +13,6 @@
 namespace featsense::viewer_export {
 namespace {
 
-using Rows = std::vector<std::pair<std::string, std::string>>;
-
 /// Rows shown in a list (events, lost periods) at most: the report holds them all.
 constexpr size_t kMaxListRows = 50;
 
@@ -29,13 +27,6 @@ std::string percent_text(const nlohmann::json* share) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f %%", 100.0 * share->get<double>());
   return text;
-}
-
-std::string table(const Rows& rows) {
-  std::string html = "<table>\n";
-  for (const auto& [name, value] : rows)
-    html += "<tr><th>" + html_escape(name) + "</th><td>" + html_escape(value) + "</td></tr>\n";
-  return html + "</table>\n";
 }
 
 /// "found after 7.0 s (scan 70) by keyframes, at (12.1, -3.4, 1.9)".
@@ -83,7 +74,7 @@ std::string summary_table(const nlohmann::json& loc) {
                       counts_text(json_at(*search, {"rejected"})));
   }
   rows.emplace_back("keyframe matches the surface refuted", text_at(loc, {"unconfirmed_matches"}));
-  return table(rows);
+  return rows_table(rows);
 }
 
 /// The resident memory as the input went on: where it began, where it ended, its peak.
@@ -128,7 +119,7 @@ std::string truth_table(const nlohmann::json& report) {
                     text_at(*eval, {"localized_over_0_5_m"}));
   return "<h3>Against the truth</h3>\n<p>Each pose against the true one at its time, in the "
          "map's frame, without any alignment.</p>\n" +
-         table(rows);
+         rows_table(rows);
 }
 
 std::string timing_text(const nlohmann::json* timing) {
@@ -151,7 +142,7 @@ std::string timing_table(const nlohmann::json& report) {
   rows.emplace_back("every scan", timing_text(json_at(*timings, {"per_scan"})));
   if (const nlohmann::json* memory = json_at(report, {"rss_mb_over_input"}))
     rows.emplace_back("resident memory", memory_text(*memory));
-  return "<h3>Time per scan, and memory</h3>\n" + table(rows);
+  return "<h3>Time per scan, and memory</h3>\n" + rows_table(rows);
 }
 
 std::string lost_periods_table(const nlohmann::json& loc) {

@@ -10,8 +10,6 @@
 namespace featsense::viewer_export {
 namespace {
 
-using Rows = std::vector<std::pair<std::string, std::string>>;
-
 double number_at(const nlohmann::json& json, std::initializer_list<const char*> keys) {
   const nlohmann::json* value = json_at(json, keys);
   return value && value->is_number() ? value->get<double>() : NAN;
@@ -103,6 +101,13 @@ std::string length_text_mm(double metres) {
   return text;
 }
 
+std::string rows_table(const Rows& rows) {
+  std::string html = "<table>\n";
+  for (const auto& [name, value] : rows)
+    html += "<tr><th>" + html_escape(name) + "</th><td>" + html_escape(value) + "</td></tr>\n";
+  return html + "</table>\n";
+}
+
 std::string summary_section(const nlohmann::json& report) {
   Rows rows;
   if (const nlohmann::json* input = json_at(report, {"input"})) {
@@ -124,10 +129,7 @@ std::string summary_section(const nlohmann::json& report) {
   add_mesh(rows, report);
   add(rows, "warnings", json_at(report, {"warnings", "count"}));
 
-  std::string html = "<h2>Summary</h2>\n<table>\n";
-  for (const auto& [name, value] : rows)
-    html += "<tr><th>" + html_escape(name) + "</th><td>" + html_escape(value) + "</td></tr>\n";
-  return html + "</table>\n" + warnings_block(report);
+  return "<h2>Summary</h2>\n" + rows_table(rows) + warnings_block(report);
 }
 
 }  // namespace featsense::viewer_export

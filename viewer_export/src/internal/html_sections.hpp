@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <initializer_list>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace featsense::viewer_export {
 
@@ -18,6 +20,12 @@ std::string json_text(const nlohmann::json& value);
 
 /// Metres as "12.3 mm" below 1 m, "1.23 m" above.
 std::string length_text_mm(double metres);
+
+/// Rows of a two-column table: a name and its value, as text.
+using Rows = std::vector<std::pair<std::string, std::string>>;
+
+/// The rows as a <table> of <th> names and <td> values, both escaped.
+std::string rows_table(const Rows& rows);
 
 /// Input, scans, duration, speed, trajectory and mesh scores, warnings.
 std::string summary_section(const nlohmann::json& report);
