@@ -32,6 +32,8 @@ find_package(assimp CONFIG REQUIRED)
 # CGAL 5.5 is header-only; its imported target keeps its headers SYSTEM so that their warnings
 # never fail our build. Only mesh/src/closest_point_query.cpp includes it.
 find_package(CGAL CONFIG REQUIRED)
+# Levels of detail of tiled meshes: meshoptimizer's simplifier (mesh/src/mesh_simplification.cpp).
+find_package(meshoptimizer CONFIG REQUIRED)
 
 # The front end (slam/features, slam/odometry): OpenCV's core and imgproc for the intensity
 # image (Debian's two packages ship no CMake config, and the full libopencv-dev pulls in about

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "common/gltf_validator.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
 #include "featsense/viewer_export/gltf_mesh_io.hpp"
@@ -31,46 +32,6 @@ mesh::TriangleMesh quad_at(const Eigen::Vector3f& offset,
   attributes->colors = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {10, 20, 30}};
   attributes->scalars = {{"cost", {0.0f, 0.25f, 0.5f, 1.0f}}};
   return m;
-}
-
-std::filesystem::path tools_dir() {
-  return std::filesystem::path(FEATSENSE_SOURCE_DIR) / "test" / "tools";
-}
-
-/// Whether node and the validator (npm install in test/tools) are present.
-bool validator_present() {
-  return std::system("command -v node >/dev/null 2>&1") == 0 &&
-         std::filesystem::exists(tools_dir() / "node_modules" / "gltf-validator");
-}
-
-struct ValidatorRun {
-  int status = -1;     ///< the exit status: 0 without errors
-  std::string output;  ///< one JSON report per file
-};
-
-/// Runs the Khronos validator (test/tools/validate_gltf.mjs) on `path`.
-ValidatorRun run_validator(const std::string& path) {
-  const std::string command =
-      "node " + (tools_dir() / "validate_gltf.mjs").string() + " " + path + " 2>&1";
-  ValidatorRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
-  const int status = pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
-
-/// Runs the Khronos validator on `path` where it is installed (GltfValidator.RejectsABrokenFile
-/// says, by skipping, where it is not); the other checks of a test run either way.
-void expect_valid(const std::string& path) {
-  if (!validator_present()) return;
-  const ValidatorRun run = run_validator(path);
-  EXPECT_EQ(run.status, 0) << run.output;
-  const nlohmann::json report = nlohmann::json::parse(run.output);
-  EXPECT_EQ(report["errors"], 0) << run.output;
 }
 
 class GltfMeshIo : public ::testing::TestWithParam<std::string> {};
