@@ -1,5 +1,6 @@
-// featsense mesh MAP -o MESH [--plan PNG]: marching cubes over a stored map (.h5 or .vdb), one
-// welded mesh, and its plan view.
+// featsense mesh MAP -o MESH [--plan PNG] [--tiles DIR]: marching cubes over a stored map (.h5
+// or .vdb), one welded mesh and its plan view, or a tile set (a mesh per tile and a 3D Tiles
+// tileset) whose memory is bounded by the tile, not the map.
 
 #include <spdlog/spdlog.h>
 
@@ -22,6 +23,7 @@
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "json_output.hpp"
 #include "map_outputs.hpp"
+#include "mesh_tile_set.hpp"
 
 namespace featsense::app {
 namespace {
@@ -42,6 +44,10 @@ struct MeshOptions {
   std::optional<std::string> plan_path;        ///< the plan view, PNG
   std::optional<double> plan_height;           ///< its cut
   std::optional<std::string> trajectory_path;  ///< the path drawn on it (and its cut)
+  std::optional<std::string> tiles_dir;        ///< the tile set's folder
+  double tile_size_m = viewer_export::TileSetSettings{}.tile_size_m;
+  bool tile_ply = true;
+  bool quiet = false;
 };
 
 /// --plan's options make sense only with it, and the file must be a PNG.
@@ -117,10 +123,30 @@ std::unique_ptr<storage::ChunkStore> open_map(const MeshOptions& options) {
   throw std::runtime_error(options.map + ": not a featsense map (expected .h5 or .vdb)");
 }
 
+/// --tiles works tile by tile; what needs the whole mesh at once needs -o.
+void check_tile_options(const MeshOptions& options) {
+  if (!options.tiles_dir) return;
+  if (!(options.tile_size_m > 0.0) || !std::isfinite(options.tile_size_m)) {
+    throw config::ConfigError("--tile-size: must be a positive number of metres, got " +
+                              std::to_string(options.tile_size_m));
+  }
+  if (options.output.empty() && (options.clean || options.simplify_ratio < 1.0 ||
+                                 options.check_self_intersections || options.plan_path)) {
+    throw config::ConfigError(
+        "--clean, --simplify, --check-self-intersections and --plan work on one mesh: give -o "
+        "FILE with --tiles (the tiles themselves are not cleaned)");
+  }
+}
+
 /// Bad option values fail before the map is read.
 void check_options(const MeshOptions& options) {
+  if (options.output.empty() && !options.tiles_dir) {
+    throw config::ConfigError("give -o MESH (one mesh), --tiles DIR (a tile set), or both");
+  }
+  check_tile_options(options);
   const std::string extension = viewer_export::mesh_extension(options.output);
-  if (extension != ".ply" && extension != ".glb" && extension != ".gltf" && extension != ".obj") {
+  if (!options.output.empty() && extension != ".ply" && extension != ".glb" &&
+      extension != ".gltf" && extension != ".obj") {
     throw config::ConfigError("-o: unknown mesh format '" + extension +
                               "' (use .ply, .glb, .gltf or .obj)");
   }
@@ -229,6 +255,19 @@ void run_mesh(const MeshOptions& options) {
   if (!options.bbox.empty()) run.settings.bbox = parse_bbox(options.bbox);
 
   std::unique_ptr<storage::ChunkStore> store = open_map(options);
+  std::optional<nlohmann::json> tiles;
+  if (options.tiles_dir) {
+    viewer_export::TileSetSettings tiling;
+    tiling.tile_size_m = options.tile_size_m;
+    tiling.meshing = run.settings;
+    tiling.write_ply = options.tile_ply;
+    tiles = write_tile_set_with_progress(*store, *options.tiles_dir, tiling, options.quiet);
+    if (options.output.empty()) {
+      if (options.json_path)
+        write_json({{"map", options.map}, {"tiles", *tiles}}, *options.json_path);
+      return;
+    }
+  }
   run.result = mesh::extract_mesh(*store, run.settings, &run.stats);
   store.reset();
   if (run.result.triangles.empty()) {
@@ -261,19 +300,31 @@ void run_mesh(const MeshOptions& options) {
         viewer_export::write_plan_view_png(run.result, paths, *options.plan_path, plan_settings);
   }
   print_summary(options, run);
-  if (options.json_path) write_json(mesh_run_json(options, run), *options.json_path);
+  if (options.json_path) {
+    nlohmann::json report = mesh_run_json(options, run);
+    if (tiles) report["tiles"] = *tiles;
+    write_json(report, *options.json_path);
+  }
 }
 
 }  // namespace
 
-Command register_mesh(CLI::App& app, const CliContext& /*context*/) {
+Command register_mesh(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<MeshOptions>();
   CLI::App* command = app.add_subcommand(
       "mesh", "Marching cubes over a map (.h5 store or .vdb): one welded mesh with normals");
   command->add_option("MAP", options->map, "The map: map.h5 (featsense map) or a .vdb export")
       ->required();
-  command->add_option("-o,--output", options->output, "Output mesh: .ply .glb .gltf .obj")
-      ->required();
+  command->add_option("-o,--output", options->output,
+                      "Output mesh: .ply .glb .gltf .obj (one mesh of the whole map)");
+  command->add_option("--tiles", options->tiles_dir,
+                      "Write a tile set here: a mesh per tile (GLB, PLY), tiles.json, and a 3D "
+                      "Tiles 1.1 tileset.json with coarser levels; memory bounded by the tile");
+  command
+      ->add_option("--tile-size", options->tile_size_m,
+                   "With --tiles: edge of a tile, metres (rounded to whole chunks)")
+      ->capture_default_str();
+  command->add_flag("!--no-tile-ply", options->tile_ply, "With --tiles: GLB only, no PLY per tile");
   command->add_option("--bbox", options->bbox,
                       "Only this box: xmin,ymin,zmin,xmax,ymax,zmax (metres, map frame)");
   command
@@ -311,7 +362,10 @@ Command register_mesh(CLI::App& app, const CliContext& /*context*/) {
       ->add_option("--trajectory", options->trajectory_path,
                    "With --plan: the sensor's path (TUM or KITTI) to draw and to cut above")
       ->check(CLI::ExistingFile);
-  return {command, [options] { run_mesh(*options); }};
+  return {command, [options, &context] {
+            options->quiet = context.quiet;
+            run_mesh(*options);
+          }};
 }
 
 }  // namespace featsense::app

@@ -110,6 +110,35 @@ TEST(CliMesh, WritesThePlanView) {
   EXPECT_NEAR(figures["plan"]["cut_high_m"].get<double>(), -0.2, 1e-9);
 }
 
+TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
+  const std::filesystem::path dir = write_sphere_map("cli_mesh_tiles");
+  const std::string map = (dir / "map.h5").string();
+  const std::string json = (dir / "tiles.json").string();
+  // Tiles of one 3.2 m chunk: the sphere's eight chunks are four columns, four tiles.
+  CommandResult result =
+      run_featsense("mesh " + map + " --tiles " + (dir / "t").string() + " --tile-size 3 -o " +
+                    (dir / "one.ply").string() + " --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("4 tiles of 3.2 m"), std::string::npos) << result.output;
+  nlohmann::json figures;
+  std::ifstream(json) >> figures;
+  const nlohmann::json& tiles = figures["tiles"];
+  EXPECT_EQ(tiles["tiles"].get<size_t>(), 4u);
+  EXPECT_EQ(tiles["triangles"].get<size_t>(), figures["triangles"].get<size_t>());
+  EXPECT_EQ(tiles["levels"].size(), 2u);
+  EXPECT_GT(tiles["peak_rss_mb"].get<double>(), 0.0);
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "t" / "tileset.json"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "t" / "tiles" / "0" / "-1_-1.ply"));
+
+  // Tiles alone, quietly, GLB only.
+  result = run_featsense("--quiet mesh " + map + " --tiles " + (dir / "q").string() +
+                         " --tile-size 3 --no-tile-ply");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, "");
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "q" / "tiles" / "0" / "0_0.glb"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "q" / "tiles" / "0" / "0_0.ply"));
+}
+
 TEST(CliMesh, ErrorsAreClear) {
   const std::filesystem::path dir = write_sphere_map("cli_mesh_errors");
   const std::string map = (dir / "map.h5").string();
@@ -140,6 +169,10 @@ TEST(CliMesh, ErrorsAreClear) {
       {"mesh " + map + out + " --bbox 10,10,10,11,11,11", "no surface to mesh inside --bbox"},
       {"mesh " + map + out + " --plan-height 1", "--plan-height goes with --plan"},
       {"mesh " + map + out + " --plan " + (dir / "plan.jpg").string(), "the plan view is a PNG"},
+      {"mesh " + map, "give -o MESH (one mesh), --tiles DIR (a tile set), or both"},
+      {"mesh " + map + " --tiles " + (dir / "t").string() + " --tile-size 0",
+       "--tile-size: must be a positive number of metres"},
+      {"mesh " + map + " --tiles " + (dir / "t").string() + " --clean", "work on one mesh"},
   };
   for (const Case& c : cases) {
     const CommandResult result = run_featsense(c.args);

@@ -1,0 +1,54 @@
+#include "mesh_tile_set.hpp"
+
+#include <cstdio>
+
+#include "featsense/bench/measurements.hpp"
+#include "progress.hpp"
+
+namespace featsense::app {
+
+nlohmann::json write_tile_set_with_progress(storage::ChunkStore& store, const std::string& dir,
+                                            const viewer_export::TileSetSettings& settings,
+                                            bool quiet) {
+  viewer_export::TileSetSettings with_progress = settings;
+  Progress progress("tiles", std::nullopt, quiet);
+  with_progress.progress = [&](std::size_t done, std::size_t total) {
+    progress.update(done, "of " + std::to_string(total));
+  };
+  const viewer_export::TileSetReport report =
+      viewer_export::write_tile_set(store, dir, with_progress);
+  progress.finish();
+
+  nlohmann::json levels = nlohmann::json::array();
+  for (const viewer_export::TileSetLevel& level : report.levels) {
+    levels.push_back({{"level", level.level},
+                      {"tiles", level.tiles},
+                      {"triangles", level.triangles},
+                      {"max_geometric_error_m", level.max_geometric_error_m}});
+  }
+  const nlohmann::json figures = {{"dir", dir},
+                                  {"tileset", dir + "/tileset.json"},
+                                  {"index", dir + "/tiles.json"},
+                                  {"tile_size_m", report.tile_size_m},
+                                  {"tiles", report.tiles},
+                                  {"triangles", report.triangles},
+                                  {"vertices", report.vertices},
+                                  {"chunks", report.chunks},
+                                  {"levels", levels},
+                                  {"meshing_s", report.meshing_seconds},
+                                  {"simplifying_s", report.simplifying_seconds},
+                                  {"writing_s", report.writing_seconds},
+                                  {"seconds", report.seconds},
+                                  {"peak_rss_mb", bench::peak_rss_mb()}};
+  if (!quiet) {
+    std::printf(
+        "%s: %zu tiles of %.1f m, %zu triangles from %zu chunks, %zu levels, in %.1f s "
+        "(meshing %.1f s, levels %.1f s, files %.1f s); tileset.json, tiles.json\n",
+        dir.c_str(), report.tiles, report.tile_size_m, report.triangles, report.chunks,
+        report.levels.size(), report.seconds, report.meshing_seconds, report.simplifying_seconds,
+        report.writing_seconds);
+  }
+  return figures;
+}
+
+}  // namespace featsense::app

@@ -1,0 +1,157 @@
+// The tile set of a map: tileset.json keeps 3D Tiles 1.1's rules (asset version, boxes that hold
+// their children and content, geometric errors falling to 0 at the full-resolution tiles,
+// content that exists), the full-resolution tiles hold the whole map's mesh, parents fewer
+// triangles than their children, the index lists the tiles, and the GLBs pass the Khronos
+// validator.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "common/gltf_validator.hpp"
+#include "common/test_data.hpp"
+#include "featsense/mesh/marching_cubes.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
+#include "featsense/viewer_export/tile_set.hpp"
+#include "mesh/map_tile_scene.hpp"
+
+namespace featsense::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::AlignedBox3d box_of(const nlohmann::json& tile) {
+  const nlohmann::json& b = tile["boundingVolume"]["box"];
+  EXPECT_EQ(b.size(), 12u);
+  const Eigen::Vector3d centre(b[0], b[1], b[2]);
+  // Axis-aligned: the half-axes along x, y and z.
+  EXPECT_EQ(b[4].get<double>(), 0.0);
+  EXPECT_EQ(b[8].get<double>(), 0.0);
+  const Eigen::Vector3d half(b[3], b[7], b[11]);
+  EXPECT_GT(half.minCoeff(), 0.0) << "a box without volume";
+  return {centre - half, centre + half};
+}
+
+struct Walk {
+  fs::path dir;
+  size_t leaf_triangles = 0;
+  size_t leaves = 0;
+  int deepest = 0;
+};
+
+/// Checks a tile and its children; returns the triangles of its content.
+size_t check_tile(const nlohmann::json& tile, const Eigen::AlignedBox3d& parent_box,
+                  double parent_error, int depth, Walk& walk) {
+  const Eigen::AlignedBox3d box = box_of(tile);
+  const double error = tile["geometricError"].get<double>();
+  EXPECT_GE(error, 0.0);
+  EXPECT_LE(error, parent_error);
+  EXPECT_TRUE(parent_box.contains(box.min()) && parent_box.contains(box.max()))
+      << "a child's box reaches outside its parent's";
+  EXPECT_EQ(tile["refine"], "REPLACE");
+  const std::string uri = tile["content"]["uri"];
+  const fs::path content = walk.dir / uri;
+  EXPECT_TRUE(fs::is_regular_file(content)) << uri;
+  const mesh::TriangleMesh m = viewer_export::read_mesh(content.string());
+  const Eigen::AlignedBox3d grown(box.min().array() - 1e-3, box.max().array() + 1e-3);
+  for (const Eigen::Vector3f& v : m.vertices) {
+    EXPECT_TRUE(grown.contains(v.cast<double>())) << uri << ": vertex outside the tile's box";
+    if (!grown.contains(v.cast<double>())) break;
+  }
+  walk.deepest = std::max(walk.deepest, depth);
+  if (!tile.contains("children")) {
+    EXPECT_EQ(error, 0.0) << "full resolution has no error";
+    walk.leaf_triangles += m.triangles.size();
+    ++walk.leaves;
+    return m.triangles.size();
+  }
+  EXPECT_GT(error, 0.0);
+  size_t children_triangles = 0;
+  for (const nlohmann::json& child : tile["children"])
+    children_triangles += check_tile(child, box, error, depth + 1, walk);
+  EXPECT_LT(m.triangles.size(), children_triangles) << uri << " is not coarser than its children";
+  return m.triangles.size();
+}
+
+TEST(TileSet, TilesetKeepsTheRulesAndTheTilesHoldTheWholeMesh) {
+  storage::MemoryChunkStore store = tile_scene_store();
+  const size_t whole = mesh::extract_mesh(store, {}).triangles.size();
+  const fs::path dir = scratch_dir("tile_set");
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;  // one chunk of 3.2 m: 4 x 4 tiles, three levels
+  size_t progress_calls = 0;
+  settings.progress = [&](size_t done, size_t total) {
+    ++progress_calls;
+    EXPECT_LE(done, total);
+  };
+  const viewer_export::TileSetReport report =
+      viewer_export::write_tile_set(store, dir.string(), settings);
+  EXPECT_EQ(report.tiles, 16u);
+  EXPECT_EQ(progress_calls, 16u);
+  EXPECT_EQ(report.triangles, whole);
+  EXPECT_NEAR(report.tile_size_m, 3.2, 1e-9);
+  ASSERT_EQ(report.levels.size(), 3u);
+  EXPECT_EQ(report.levels[2].tiles, 1u);
+  EXPECT_LT(report.levels[1].triangles, report.levels[0].triangles);
+
+  nlohmann::json tileset;
+  std::ifstream(dir / "tileset.json") >> tileset;
+  EXPECT_EQ(tileset["asset"]["version"], "1.1");
+  const nlohmann::json& root = tileset["root"];
+  const Eigen::AlignedBox3d everything(Eigen::Vector3d::Constant(-1e9),
+                                       Eigen::Vector3d::Constant(1e9));
+  Walk walk{dir};
+  check_tile(root, everything, tileset["geometricError"].get<double>(), 0, walk);
+  EXPECT_EQ(walk.leaves, 16u);
+  EXPECT_EQ(walk.leaf_triangles, whole);
+  EXPECT_EQ(walk.deepest, 2);
+
+  nlohmann::json index;
+  std::ifstream(dir / "tiles.json") >> index;
+  ASSERT_EQ(index["tiles"].size(), 16u);
+  size_t indexed = 0;
+  for (const nlohmann::json& tile : index["tiles"]) {
+    indexed += tile["triangles"].get<size_t>();
+    EXPECT_TRUE(fs::is_regular_file(dir / tile["ply"].get<std::string>()));
+    EXPECT_EQ(
+        viewer_export::read_mesh((dir / tile["ply"].get<std::string>()).string()).triangles.size(),
+        tile["triangles"].get<size_t>());
+  }
+  EXPECT_EQ(indexed, whole);
+
+  expect_valid((dir / root["content"]["uri"].get<std::string>()).string());
+  expect_valid((dir / "tiles/0/0_0.glb").string());
+}
+
+TEST(TileSet, OneTileIsItsOwnRootAndBadInputIsRefused) {
+  // Tiles start at the map's origin: a floor inside the first chunk is one tile.
+  storage::MemoryChunkStore store(test_metadata(kTileSceneVoxel, kTileSceneTau));
+  write_field(store, Eigen::Vector3i(5, 5, 0), Eigen::Vector3i(50, 50, 40),
+              [](const Eigen::Vector3d& p) { return p.z() - 1.0; });
+  const fs::path dir = scratch_dir("tile_set_one");
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 100.0;
+  settings.write_ply = false;
+  const viewer_export::TileSetReport report =
+      viewer_export::write_tile_set(store, dir.string(), settings);
+  EXPECT_EQ(report.tiles, 1u);
+  ASSERT_EQ(report.levels.size(), 1u);
+  EXPECT_EQ(report.root.geometric_error_m, 0.0);
+  EXPECT_FALSE(fs::exists(dir / "tiles/0/0_0.ply"));
+
+  settings.level_ratio = 1.0;
+  EXPECT_THROW(viewer_export::write_tile_set(store, dir.string(), settings), std::invalid_argument);
+  settings.level_ratio = 0.25;
+  settings.tile_size_m = -1.0;
+  EXPECT_THROW(viewer_export::write_tile_set(store, dir.string(), settings), std::invalid_argument);
+  storage::MemoryChunkStore empty(test_metadata(kTileSceneVoxel, kTileSceneTau));
+  settings.tile_size_m = 50.0;
+  EXPECT_THROW(viewer_export::write_tile_set(empty, dir.string(), settings), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace featsense::test

@@ -1,0 +1,304 @@
+// The tile set: full-resolution tiles meshed one at a time, the quadtree of coarser levels
+// built depth first (each parent as soon as its children are done), the index and the
+// tileset written at the end.
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "featsense/mesh/map_tiles.hpp"
+#include "featsense/mesh/mesh_simplification.hpp"
+#include "featsense/viewer_export/gltf_mesh_io.hpp"
+#include "featsense/viewer_export/ply_mesh_io.hpp"
+#include "featsense/viewer_export/tile_set.hpp"
+
+namespace featsense::viewer_export {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The node holding quadtree coordinate a (>= 0) at a level.
+int32_t at_level(int32_t a, int level) { return a >> level; }
+
+/// Bounds of a mesh's vertices, grown by `pad` on every side so that a flat tile (a floor
+/// alone) still has a box with volume.
+Eigen::AlignedBox3d padded_bounds(const mesh::TriangleMesh& mesh, double pad) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3f& v : mesh.vertices) box.extend(v.cast<double>());
+  box.min().array() -= pad;
+  box.max().array() += pad;
+  return box;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+class TileSetBuilder {
+ public:
+  TileSetBuilder(storage::ChunkStore& store, const fs::path& dir, const TileSetSettings& settings)
+      : tiles_(store, mesh::chunks_per_tile_for(settings.tile_size_m, store.metadata())),
+        dir_(dir),
+        settings_(settings),
+        pad_m_(0.5 * store.metadata().voxel_size_m) {
+    const std::vector<mesh::TileIndex> tiles = tiles_.tiles();
+    // The quadtree starts at the first tile, so that its coordinates are >= 0 and a map that
+    // straddles the origin still has one root.
+    for (const mesh::TileIndex& tile : tiles) {
+      origin_.x = std::min(origin_.x, tile.x);
+      origin_.y = std::min(origin_.y, tile.y);
+    }
+    for (const mesh::TileIndex& tile : tiles)
+      leaves_.insert({tile.x - origin_.x, tile.y - origin_.y});
+    report_.tile_size_m = tiles_.tile_size_m();
+  }
+
+  TileSetReport build() {
+    const auto start = Clock::now();
+    if (leaves_.empty()) throw std::runtime_error("the map holds no chunks: nothing to mesh");
+    // The root's level: the first at which every tile falls into one node.
+    int top = 0;
+    while (top < 31 && !one_node_at(top)) ++top;
+    for (int level = 0; level <= top; ++level) {
+      std::set<std::pair<int32_t, int32_t>> nodes;
+      for (const auto& [x, y] : leaves_) nodes.insert({at_level(x, level), at_level(y, level)});
+      present_.push_back(std::move(nodes));
+    }
+    report_.levels.resize(static_cast<std::size_t>(top) + 1);
+    for (int level = 0; level <= top; ++level)
+      report_.levels[static_cast<std::size_t>(level)].level = level;
+    const auto& root_index = *present_.back().begin();
+    std::optional<Built> root = build_node(top, root_index.first, root_index.second);
+    if (!root) throw std::runtime_error("the map has no surface to mesh");
+    report_.root = std::move(root->node);
+    const auto writing = Clock::now();
+    write_text(dir_ / "tileset.json", tileset_json(report_.root));
+    write_index();
+    report_.writing_seconds += seconds_since(writing);
+    report_.seconds = seconds_since(start);
+    return report_;
+  }
+
+ private:
+  /// A node done: its entry, and its content simplified for its parent.
+  struct Built {
+    TileSetNode node;
+    mesh::TriangleMesh for_parent;
+    double for_parent_error_m = 0.0;  ///< of for_parent against full resolution
+  };
+
+  bool one_node_at(int level) const {
+    const auto& [x0, y0] = *leaves_.begin();
+    return std::all_of(leaves_.begin(), leaves_.end(), [&](const auto& leaf) {
+      return at_level(leaf.first, level) == at_level(x0, level) &&
+             at_level(leaf.second, level) == at_level(y0, level);
+    });
+  }
+
+  std::string content_path(int level, int32_t x, int32_t y, const char* extension) const {
+    return "tiles/" + std::to_string(level) + "/" + std::to_string(x) + "_" + std::to_string(y) +
+           extension;
+  }
+
+  std::optional<Built> build_node(int level, int32_t x, int32_t y) {
+    if (present_[static_cast<std::size_t>(level)].count({x, y}) == 0) return std::nullopt;
+    return level == 0 ? build_leaf(x, y) : build_parent(level, x, y);
+  }
+
+  /// (qx, qy): quadtree coordinates; the tile's own index is (qx, qy) + origin.
+  std::optional<Built> build_leaf(int32_t qx, int32_t qy) {
+    const int32_t x = qx + origin_.x;
+    const int32_t y = qy + origin_.y;
+    auto start = Clock::now();
+    mesh::MeshingStats stats;
+    mesh::TriangleMesh full = tiles_.mesh({x, y}, settings_.meshing, &stats);
+    report_.meshing_seconds += seconds_since(start);
+    report_.chunks += stats.chunks;
+    ++leaves_done_;
+    if (settings_.progress) settings_.progress(leaves_done_, leaves_.size());
+    if (full.triangles.empty()) return std::nullopt;
+
+    Built built;
+    built.node.level = 0;
+    built.node.x = x;
+    built.node.y = y;
+    built.node.box = padded_bounds(full, pad_m_);
+    built.node.triangles = full.triangles.size();
+    built.node.content = content_path(0, x, y, ".glb");
+    write_content(built.node.content, full);
+    if (settings_.write_ply) {
+      start = Clock::now();
+      write_ply_mesh((dir_ / content_path(0, x, y, ".ply")).string(), full);
+      report_.writing_seconds += seconds_since(start);
+    }
+    report_.tiles += 1;
+    report_.triangles += full.triangles.size();
+    report_.vertices += full.vertices.size();
+    count(built.node);
+    simplify_for_parent(full, 0, qx, qy, built);
+    return built;
+  }
+
+  std::optional<Built> build_parent(int level, int32_t x, int32_t y) {
+    std::vector<Built> children;
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        std::optional<Built> child = build_node(level - 1, 2 * x + i, 2 * y + j);
+        if (child) children.push_back(std::move(*child));
+      }
+    if (children.empty()) return std::nullopt;
+
+    Built built;
+    built.node.level = level;
+    built.node.x = x;
+    built.node.y = y;
+    std::vector<const mesh::TriangleMesh*> parts;
+    for (Built& child : children) {
+      built.node.box.extend(child.node.box);
+      built.node.geometric_error_m =
+          std::max(built.node.geometric_error_m, child.for_parent_error_m);
+      parts.push_back(&child.for_parent);
+    }
+    const auto start = Clock::now();
+    mesh::TriangleMesh content = mesh::weld_by_position(parts);
+    report_.simplifying_seconds += seconds_since(start);
+    for (Built& child : children) {
+      child.for_parent = {};
+      built.node.children.push_back(std::move(child.node));
+    }
+    built.node.triangles = content.triangles.size();
+    built.node.content = content_path(level, x, y, ".glb");
+    write_content(built.node.content, content);
+    count(built.node);
+    simplify_for_parent(content, level, x, y, built);
+    built.for_parent_error_m += built.node.geometric_error_m;
+    return built;
+  }
+
+  /// The parent's share of node (qx, qy) at `level`: a quarter of its triangles, its cut held
+  /// (the vertices on the four lines where the node meets its neighbours), so that the parent
+  /// meets its neighbours where the full-resolution tiles do.
+  void simplify_for_parent(const mesh::TriangleMesh& content, int level, int32_t qx, int32_t qy,
+                           Built& built) {
+    const auto start = Clock::now();
+    const auto cut = [&](int32_t q, int32_t origin) {
+      return static_cast<float>(tiles_.cut_m(q * (int32_t{1} << level) + origin));
+    };
+    const float x0 = cut(qx, origin_.x);
+    const float x1 = cut(qx + 1, origin_.x);
+    const float y0 = cut(qy, origin_.y);
+    const float y1 = cut(qy + 1, origin_.y);
+    std::vector<bool> held(content.vertices.size());
+    for (std::size_t v = 0; v < held.size(); ++v) {
+      const Eigen::Vector3f& p = content.vertices[v];
+      held[v] = p.x() == x0 || p.x() == x1 || p.y() == y0 || p.y() == y1;
+    }
+    mesh::SimplifySettings simplify;
+    simplify.target_ratio = settings_.level_ratio;
+    const double parent_edge_m = report_.tile_size_m * static_cast<double>(int64_t{2} << level);
+    simplify.max_error_m = settings_.max_error_share * parent_edge_m;
+    mesh::SimplifiedMesh simplified = mesh::simplify_mesh(content, simplify, held);
+    built.for_parent = std::move(simplified.mesh);
+    built.for_parent_error_m = simplified.error_m;
+    report_.simplifying_seconds += seconds_since(start);
+  }
+
+  void write_content(const std::string& relative, const mesh::TriangleMesh& content) {
+    const auto start = Clock::now();
+    const fs::path path = dir_ / relative;
+    fs::create_directories(path.parent_path());
+    write_gltf_mesh(path.string(), content, {}, true);
+    report_.writing_seconds += seconds_since(start);
+  }
+
+  void count(const TileSetNode& node) {
+    TileSetLevel& level = report_.levels[static_cast<std::size_t>(node.level)];
+    level.tiles += 1;
+    level.triangles += node.triangles;
+    level.max_geometric_error_m = std::max(level.max_geometric_error_m, node.geometric_error_m);
+  }
+
+  /// tiles.json: the full-resolution tiles, for tools that want meshes, not a tileset.
+  void write_index() const {
+    nlohmann::json tiles = nlohmann::json::array();
+    std::vector<const TileSetNode*> stack{&report_.root};
+    std::vector<const TileSetNode*> leaves;
+    while (!stack.empty()) {
+      const TileSetNode* node = stack.back();
+      stack.pop_back();
+      if (node->level == 0) leaves.push_back(node);
+      for (const TileSetNode& child : node->children) stack.push_back(&child);
+    }
+    std::sort(leaves.begin(), leaves.end(), [](const TileSetNode* a, const TileSetNode* b) {
+      return a->x != b->x ? a->x < b->x : a->y < b->y;
+    });
+    for (const TileSetNode* leaf : leaves) {
+      nlohmann::json tile = {{"x", leaf->x},
+                             {"y", leaf->y},
+                             {"triangles", leaf->triangles},
+                             {"bounds_m",
+                              {leaf->box.min().x(), leaf->box.min().y(), leaf->box.min().z(),
+                               leaf->box.max().x(), leaf->box.max().y(), leaf->box.max().z()}},
+                             {"glb", leaf->content}};
+      if (settings_.write_ply) tile["ply"] = content_path(0, leaf->x, leaf->y, ".ply");
+      tiles.push_back(std::move(tile));
+    }
+    const nlohmann::json index = {{"frame", "map (Z up, metres)"},
+                                  {"tile_size_m", report_.tile_size_m},
+                                  {"chunks_per_tile", tiles_.chunks_per_tile()},
+                                  {"triangles", report_.triangles},
+                                  {"tileset", "tileset.json"},
+                                  {"tiles", std::move(tiles)}};
+    write_text(dir_ / "tiles.json", index.dump(1) + "\n");
+  }
+
+  mesh::MapTiles tiles_;
+  fs::path dir_;
+  TileSetSettings settings_;
+  double pad_m_;
+  mesh::TileIndex origin_{std::numeric_limits<int32_t>::max(), std::numeric_limits<int32_t>::max()};
+  std::set<std::pair<int32_t, int32_t>> leaves_;  ///< quadtree coordinates of the tiles
+  std::vector<std::set<std::pair<int32_t, int32_t>>> present_;  ///< nodes per level
+  std::size_t leaves_done_ = 0;
+  TileSetReport report_;
+};
+
+}  // namespace
+
+TileSetReport write_tile_set(storage::ChunkStore& store, const std::string& dir,
+                             const TileSetSettings& settings) {
+  if (!(settings.max_error_share > 0.0) || !std::isfinite(settings.max_error_share)) {
+    throw std::invalid_argument("tile set: the error bound's share of a tile must be > 0, got " +
+                                std::to_string(settings.max_error_share));
+  }
+  if (!(settings.level_ratio > 0.0 && settings.level_ratio < 1.0)) {
+    throw std::invalid_argument(
+        "tile set: a parent keeps a share in (0, 1) of its children's "
+        "triangles, got " +
+        std::to_string(settings.level_ratio));
+  }
+  fs::create_directories(dir);
+  return TileSetBuilder(store, dir, settings).build();
+}
+
+}  // namespace featsense::viewer_export
