@@ -60,7 +60,8 @@ class TileSetBuilder {
       : tiles_(store, mesh::chunks_per_tile_for(settings.tile_size_m, store.metadata())),
         dir_(dir),
         settings_(settings),
-        pad_m_(0.5 * store.metadata().voxel_size_m) {
+        pad_m_(0.5 * store.metadata().voxel_size_m),
+        voxel_m_(store.metadata().voxel_size_m) {
     const std::vector<mesh::TileIndex> tiles = tiles_.tiles();
     // The quadtree starts at the first tile, so that its coordinates are >= 0 and a map that
     // straddles the origin still has one root.
@@ -103,8 +104,9 @@ class TileSetBuilder {
   /// A node done: its entry, and its content simplified for its parent.
   struct Built {
     TileSetNode node;
+    double deviation_m = 0.0;  ///< of its content from full resolution (simplifier's estimate)
     mesh::TriangleMesh for_parent;
-    double for_parent_error_m = 0.0;  ///< of for_parent against full resolution
+    double for_parent_error_m = 0.0;  ///< of for_parent from the content
   };
 
   bool one_node_at(int level) const {
@@ -175,12 +177,20 @@ class TileSetBuilder {
     std::vector<const mesh::TriangleMesh*> parts;
     for (Built& child : children) {
       built.node.box.extend(child.node.box);
-      built.node.geometric_error_m =
-          std::max(built.node.geometric_error_m, child.for_parent_error_m);
+      built.deviation_m = std::max(built.deviation_m, child.deviation_m + child.for_parent_error_m);
       parts.push_back(&child.for_parent);
     }
+    // A level keeps about a quarter of the triangles of the one below, so its vertices lie
+    // about twice as far apart: it cannot show what is smaller than 2^level voxels, however
+    // flat the surfaces that it does show. Its error is at least that, so that a viewer
+    // refines to full resolution where voxel-sized detail is visible.
+    built.node.geometric_error_m =
+        std::max(built.deviation_m, voxel_m_ * static_cast<double>(int64_t{1} << level));
     const auto start = Clock::now();
     mesh::TriangleMesh content = mesh::weld_by_position(parts);
+    // The kept vertices' normals are those of the surface around each at full resolution;
+    // over large triangles they shade as facets. The writer makes area-weighted ones instead.
+    content.normals.clear();
     report_.simplifying_seconds += seconds_since(start);
     for (Built& child : children) {
       child.for_parent = {};
@@ -191,7 +201,6 @@ class TileSetBuilder {
     write_content(built.node.content, content);
     count(built.node);
     simplify_for_parent(content, level, x, y, built);
-    built.for_parent_error_m += built.node.geometric_error_m;
     return built;
   }
 
@@ -276,6 +285,7 @@ class TileSetBuilder {
   fs::path dir_;
   TileSetSettings settings_;
   double pad_m_;
+  double voxel_m_;
   mesh::TileIndex origin_{std::numeric_limits<int32_t>::max(), std::numeric_limits<int32_t>::max()};
   std::set<std::pair<int32_t, int32_t>> leaves_;  ///< quadtree coordinates of the tiles
   std::vector<std::set<std::pair<int32_t, int32_t>>> present_;  ///< nodes per level

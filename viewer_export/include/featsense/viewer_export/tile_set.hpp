@@ -7,10 +7,11 @@
 /// The tiles are those of mesh::MapTiles (whole chunk columns, welded without seams). A parent
 /// of the quadtree holds its (up to) four children simplified to a quarter (within an error
 /// bound that grows with the level) and joined, their outer border held so that neighbours of
-/// one level meet; its geometric error is the largest
-/// simplification error on the way down from it (meshoptimizer's estimate, metres), a leaf's
-/// is 0. Memory: one tile's full mesh and, per level of the quadtree, up to four coarser
-/// meshes of about a tile's size: bounded by the tile, not by the map.
+/// one level meet. A parent's geometric error is the larger of the summed simplification errors
+/// on the way down from it (meshoptimizer's estimate, metres) and its resolution, 2^level
+/// voxels (its vertices lie about that far apart); a leaf's is 0. Memory: one tile's full mesh and,
+/// per level of the quadtree, up to four coarser meshes of about a tile's size: bounded by the
+/// tile, not by the map.
 ///
 /// Layout of `dir`: `tileset.json`, `tiles.json`, `tiles/<level>/<x>_<y>.glb` (level 0: the
 /// full-resolution tiles, also `.ply`). Frames: the map frame, Z up, metres; the GLB content is
