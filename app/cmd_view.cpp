@@ -1,5 +1,6 @@
 // featsense view OUT/: the map in the browser. A small HTTP server on this machine serves the
-// page, the mesh, the paths and the plan view of one output folder until Ctrl+C.
+// page, the mesh, the paths and the plan view of one output folder, or a tile set streamed by
+// level of detail, until Ctrl+C.
 
 #include <atomic>
 #include <chrono>
@@ -23,15 +24,27 @@ struct ViewOptions {
   std::string host = "127.0.0.1";
   int port = 8765;
   std::string three_folder = kThreeJsFolder;
+  std::string web_modules = default_web_modules_folder().string();
   ViewSettings settings;
 };
 
 void run_view(const ViewOptions& options, const CliContext& context) {
   const Clock::time_point start = Clock::now();
-  ViewServer server(load_view_content(options.folder, options.settings), options.three_folder);
+  std::unique_ptr<ViewServer> server_owner;
+  std::string loaded;
+  if (is_tile_set_folder(options.folder)) {
+    TileSetSite site = load_tile_set_site(options.folder, options.web_modules);
+    loaded = "tile set " + options.folder + " (" + std::to_string(site.tiles) + " tiles)";
+    server_owner = std::make_unique<ViewServer>(std::move(site));
+  } else {
+    loaded = options.folder;
+    server_owner = std::make_unique<ViewServer>(load_view_content(options.folder, options.settings),
+                                                options.three_folder);
+  }
+  ViewServer& server = *server_owner;
   const int port = server.bind(options.host, options.port);
   if (!context.quiet) {
-    std::printf("featsense view: %s loaded in %.1f s\n", options.folder.c_str(),
+    std::printf("featsense view: %s loaded in %.1f s\n", loaded.c_str(),
                 std::chrono::duration<double>(Clock::now() - start).count());
   }
   // The URL always: it is what the command is for (also with --quiet).
@@ -59,7 +72,9 @@ Command register_view(CLI::App& app, const CliContext& context) {
       "view",
       "Show an output folder (mesh, paths, plan view) in the browser: serves it on this machine "
       "and prints the URL; Ctrl+C stops");
-  command->add_option("FOLDER", options->folder, "Output folder of featsense map, demo or mesh")
+  command
+      ->add_option("FOLDER", options->folder,
+                   "Output folder of featsense map, demo or mesh, or a tile set (mesh --tiles)")
       ->required();
   command->add_option("--port", options->port, "Port; 0 takes any free one")
       ->check(CLI::Range(0, 65535))
@@ -74,6 +89,11 @@ Command register_view(CLI::App& app, const CliContext& context) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command->add_option("--three", options->three_folder, "Folder of three.js (Debian's libjs-three)")
+      ->capture_default_str();
+  command
+      ->add_option("--web-modules", options->web_modules,
+                   "For a tile set: the npm modules three and 3d-tiles-renderer "
+                   "(scripts/install-web.sh)")
       ->capture_default_str();
   return {command, [options, &context] { run_view(*options, context); }};
 }

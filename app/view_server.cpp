@@ -57,6 +57,7 @@ void reuse_address_only(socket_t sock) {
 
 struct ViewServer::Impl {
   ViewContent content;
+  TileSetSite tiles;
   std::shared_ptr<const LiveView> live;
   std::map<std::string, StaticFile> three;
   httplib::Server server;
@@ -65,8 +66,7 @@ struct ViewServer::Impl {
   std::atomic<bool> finished{false};
 };
 
-void ViewServer::serve_page(const fs::path& three_folder, const std::string& home) {
-  impl_->three = read_three_js(three_folder);
+void ViewServer::serve_page_files(const std::string& home) {
   httplib::Server& server = impl_->server;
   server.set_socket_options(reuse_address_only);
   for (const viewer_export::PageFile& file : viewer_export::viewer_page_files()) {
@@ -76,6 +76,12 @@ void ViewServer::serve_page(const fs::path& three_folder, const std::string& hom
     server.Get(file.path, serve);
     if (file.path == home) server.Get("/", serve);
   }
+}
+
+void ViewServer::serve_page(const fs::path& three_folder, const std::string& home) {
+  impl_->three = read_three_js(three_folder);
+  serve_page_files(home);
+  httplib::Server& server = impl_->server;
   for (const auto& [route, file] : impl_->three) {
     const StaticFile* served = &file;
     server.Get("/three/" + route, [served](const httplib::Request&, httplib::Response& response) {
@@ -140,6 +146,42 @@ ViewServer::ViewServer(std::shared_ptr<const LiveView> live, const fs::path& thr
                response.set_content(view->changes_since(count_parameter(request, "since")),
                                     "application/octet-stream");
              });
+}
+
+namespace {
+
+const char* content_type_of(const fs::path& file) {
+  const std::string extension = file.extension().string();
+  if (extension == ".js") return kJavaScript;
+  if (extension == ".json") return kJson;
+  if (extension == ".glb") return "model/gltf-binary";
+  return "application/octet-stream";
+}
+
+/// Serves `prefix`(.*) from `files`, the captured rest of the path only a key into it.
+void serve_listed(httplib::Server& server, const std::string& prefix,
+                  const std::map<std::string, fs::path>* files) {
+  server.Get(prefix + "(.*)",
+             [files](const httplib::Request& request, httplib::Response& response) {
+               const auto found = files->find(request.matches[1].str());
+               std::optional<std::string> bytes;
+               if (found != files->end()) bytes = read_file_bytes(found->second);
+               if (!bytes) {
+                 response.status = 404;
+                 response.set_content("no such file", "text/plain");
+                 return;
+               }
+               response.set_content(std::move(*bytes), content_type_of(found->second));
+             });
+}
+
+}  // namespace
+
+ViewServer::ViewServer(TileSetSite tiles) : impl_(std::make_unique<Impl>()) {
+  serve_page_files("/tiles.html");
+  impl_->tiles = std::move(tiles);
+  serve_listed(impl_->server, "/tileset/", &impl_->tiles.tileset_files);
+  serve_listed(impl_->server, "/modules/", &impl_->tiles.module_files);
 }
 
 ViewServer::~ViewServer() = default;

@@ -11,6 +11,9 @@
 // or, serving a live run (live_view.hpp), the live page at / and
 //   /live/status.json?path_from=N   the run's figures, the latest pose, the path from N on
 //   /live/mesh.bin?since=V          the chunks changed after version V
+// or, serving a tile set (view_tile_set.hpp), the tile-set page at / and
+//   /tileset/tileset.json, /tileset/tiles/L/X_Y.glb   the files listed at start
+//   /modules/...                    three.js and 3d-tiles-renderer, the files listed at start
 
 #include <atomic>
 #include <filesystem>
@@ -19,6 +22,7 @@
 
 #include "live_view.hpp"
 #include "view_content.hpp"
+#include "view_tile_set.hpp"
 
 namespace featsense::app {
 
@@ -32,6 +36,8 @@ class ViewServer {
   ViewServer(ViewContent content, const std::filesystem::path& three_folder);
   /// Serves a live run's map as it grows (`featsense live --view`).
   ViewServer(std::shared_ptr<const LiveView> live, const std::filesystem::path& three_folder);
+  /// Serves a tile set to the tile-set page (no Debian three.js needed).
+  explicit ViewServer(TileSetSite tiles);
   ~ViewServer();
   ViewServer(const ViewServer&) = delete;
   ViewServer& operator=(const ViewServer&) = delete;
@@ -48,6 +54,8 @@ class ViewServer {
   struct Impl;
   /// The page and three.js; `home` is the page served at /.
   void serve_page(const std::filesystem::path& three_folder, const std::string& home);
+  /// The page's files; `home` is served at / too.
+  void serve_page_files(const std::string& home);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -5,6 +5,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bash "$root/scripts/install-deps.sh"
+bash "$root/scripts/install-web.sh"
 build="${FEATSENSE_BUILD_DIR:-$root/build}"
 cmake -S "$root" -B "$build" -G Ninja > /dev/null
 cmake --build "$build" --parallel "$(nproc)" --target featsense

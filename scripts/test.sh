@@ -4,6 +4,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bash "$root/scripts/install-deps.sh"
+bash "$root/scripts/install-web.sh"
 # The glTF tests run the Khronos validator, and the browser tests (report.html, the viewer)
 # drive Debian's Chromium with playwright-core, where they can be installed; where either
 # install fails, the tests that need it skip with a message.

@@ -1,5 +1,6 @@
 // featsense view end to end: the bad paths (one clear message, a non-zero exit), a server that
-// prints its URL and stops on Ctrl+C, and the page in headless Chromium with the mesh drawn.
+// prints its URL and stops on Ctrl+C, and the page in headless Chromium with the mesh drawn; a
+// tile set streamed, coarse from afar and at full resolution close up.
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -17,6 +18,8 @@
 #include "common/page_check.hpp"
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
+#include "featsense/viewer_export/tile_set.hpp"
+#include "mesh/map_tile_scene.hpp"
 
 // Last: <resolv.h>, which httplib.h includes, defines a macro `_res` that Eigen's headers use
 // as a parameter name.
@@ -157,6 +160,69 @@ TEST(CliView, ThePageDrawsTheMeshInHeadlessChromium) {
   EXPECT_EQ(check.result["loaded"], true) << check.output;
   EXPECT_TRUE(check.result["console_errors"].empty()) << check.output;
   // The room fills about half the view; the panel alone differs in about 12 % of it.
+  EXPECT_GT(check.result["differing_fraction"].get<double>(), 0.3) << check.output;
+  EXPECT_EQ(view.stop(), 0);
+}
+
+/// The npm modules of the tile-set page, where scripts/install-web.sh put them.
+bool web_modules_present() {
+  return fs::is_directory(fs::path(FEATSENSE_SOURCE_DIR) / "viewer_export" / "web" / "npm" /
+                          "node_modules" / "3d-tiles-renderer");
+}
+
+/// A tile set of 4 x 4 tiles of 3.2 m with three levels (test/mesh/map_tile_scene.hpp).
+fs::path write_test_tile_set(const std::string& name) {
+  const fs::path dir = scratch_dir(name);
+  storage::MemoryChunkStore store = tile_scene_store();
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;
+  settings.write_ply = false;
+  viewer_export::write_tile_set(store, dir.string(), settings);
+  return dir;
+}
+
+TEST(CliView, ATileSetWithoutItsModulesIsOneClearError) {
+  const fs::path dir = write_test_tile_set("cli_view_tiles_no_modules");
+  expect_one_clear_error(
+      run_featsense("view " + dir.string() + " --web-modules " + (dir / "x").string()),
+      "scripts/install-web.sh");
+}
+
+TEST(CliView, ATileSetStreamsCoarseFromAfarAndFullResolutionCloseUp) {
+  if (!web_modules_present()) GTEST_SKIP() << "no npm modules (scripts/install-web.sh)";
+  const fs::path dir = write_test_tile_set("cli_view_tiles");
+  ViewProcess view(dir.string() + " --port 0 --quiet");
+  const std::string url = view.first_line();
+  ASSERT_EQ(url.rfind("http://127.0.0.1:", 0), 0u) << url;
+
+  // Only the files listed at start are served: nothing by a path of the request's choosing.
+  httplib::Client client(url.substr(0, url.size() - 1));
+  EXPECT_EQ(client.Get("/tileset/tileset.json")->status, 200);
+  EXPECT_EQ(client.Get("/tileset/tiles/0/0_0.glb")->status, 200);
+  EXPECT_EQ(client.Get("/tileset/../tileset.json")->status, 404);
+  EXPECT_EQ(client.Get("/tileset/tiles.json")->status, 404);
+  EXPECT_EQ(client.Get("/modules/three/package.json")->status, 404);
+  EXPECT_EQ(client.Get("/modules/three/build/three.module.js")->status, 200);
+
+  // From afar: the whole map from its coarsest level.
+  const std::string afar = (dir / "afar.png").string();
+  PageCheck check = run_page_check(url, afar, "window.featsenseTiles.firstFrameMs !== null", 60000,
+                                   "window.featsenseTiles");
+  if (check.skipped) GTEST_SKIP() << check.output;
+  ASSERT_EQ(check.exit_code, 0) << check.output;
+  EXPECT_TRUE(check.result["console_errors"].empty()) << check.output;
+  EXPECT_GT(check.result["differing_fraction"].get<double>(), 0.1) << check.output;
+  const nlohmann::json& far = check.result["reported"];
+  EXPECT_TRUE(far["errors"].empty()) << check.output;
+  EXPECT_EQ(far["fullResolutionShown"], 0) << check.output;
+
+  // Close to the ball (2 m): full-resolution tiles replace the coarse ones there.
+  const std::string close = (dir / "close.png").string();
+  check = run_page_check(url + "?focus=0.2,-0.1,0.7&distance=2", close,
+                         "window.featsenseTiles.fullResolutionShown > 0", 60000,
+                         "window.featsenseTiles");
+  ASSERT_EQ(check.exit_code, 0) << check.output;
+  EXPECT_TRUE(check.result["reported"]["visible"]["0"].size() > 0) << check.output;
   EXPECT_GT(check.result["differing_fraction"].get<double>(), 0.3) << check.output;
   EXPECT_EQ(view.stop(), 0);
 }

@@ -2,7 +2,8 @@
 /// The viewer page (`featsense view`): its HTML, JavaScript and CSS, kept as files in
 /// viewer_export/web/ and built into the program (cmake/FeatsenseEmbed.cmake), so that the
 /// page always matches the server that serves it and nothing needs installing beside the
-/// program. three.js is not among them: it comes from Debian's libjs-three at run time.
+/// program. three.js is not among them: it comes from Debian's libjs-three at run time (and,
+/// for the tile-set page, with 3d-tiles-renderer from npm: scripts/install-web.sh).
 
 #include <string>
 #include <vector>
