@@ -318,11 +318,18 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
   if (!options.no_mesh && !options.poses_only && mapped.frames_mapped > 0) {
     const MeshErrorOutputs error_outputs{
         out, plan_inputs(options, result.final_poses, !result.odometry, truth)};
-    const MapMesh meshed = mesh_map(out / "map.h5", out, error_outputs.plan);
-    report["mesh"] = mesh_json(meshed);
-    if (std::optional<nlohmann::json> evaluation =
-            evaluate_map_mesh(meshed.mesh, references, T_truth_estimate, &error_outputs)) {
-      report["eval"]["mesh"] = *evaluation;
+    if (options.tiles) {
+      // The overview is a coarser level: comparing it with the truth would measure the
+      // simplification, not the map.
+      report["mesh"] =
+          mesh_json(mesh_map_tiles(out / "map.h5", out, error_outputs.plan, context.quiet));
+    } else {
+      const MapMesh meshed = mesh_map(out / "map.h5", out, error_outputs.plan);
+      report["mesh"] = mesh_json(meshed);
+      if (std::optional<nlohmann::json> evaluation =
+              evaluate_map_mesh(meshed.mesh, references, T_truth_estimate, &error_outputs)) {
+        report["eval"]["mesh"] = *evaluation;
+      }
     }
   }
   report["html"] = kReportHtml;
@@ -360,6 +367,9 @@ void add_map_output_flags(CLI::App& command, MapOptions& options) {
   command.add_flag("--overwrite", options.overwrite, "Replace OUT/map.h5 if it exists");
   command.add_flag("--no-mesh", options.no_mesh,
                    "Write the map only, no mesh.ply / mesh.glb / topdown.png");
+  command.add_flag("--tiles", options.tiles,
+                   "The mesh as a tile set (OUT/tiles/: a mesh per tile, 3D Tiles), memory "
+                   "bounded by a tile, for large maps; not compared with a reference");
   command.add_flag("--no-loop-closure", options.no_loop_closure,
                    "Map with the odometry's poses alone (loop.enabled false)");
 }

@@ -36,6 +36,7 @@ struct MapOptions {
   std::optional<double> plan_height;  ///< topdown.png's cut, map frame z; default: the path's
   bool overwrite = false;
   bool no_mesh = false;
+  bool tiles = false;            ///< the mesh as a tile set (OUT/tiles/), not one mesh.ply
   bool no_loop_closure = false;  ///< loop.enabled false
   bool poses_only = false;       ///< the poses and the report, no map
   bool print_summary = true;     ///< the one-line summary on stdout
@@ -49,7 +50,7 @@ struct MapOutcome {
   nlohmann::json report;  ///< as written to report.json
 };
 
-/// Adds --overwrite, --no-mesh and --no-loop-closure (MapOptions') to `command`.
+/// Adds --overwrite, --no-mesh, --tiles and --no-loop-closure (MapOptions') to `command`.
 void add_map_output_flags(CLI::App& command, MapOptions& options);
 
 /// The true path where it is known, for the report's eval.traj (SE(3)-aligned, as `featsense

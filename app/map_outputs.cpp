@@ -9,6 +9,7 @@
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/plan_view.hpp"
 #include "mesh_error_files.hpp"
+#include "mesh_tile_set.hpp"
 
 namespace featsense::app {
 namespace {
@@ -55,6 +56,32 @@ MapMesh mesh_map(const fs::path& map_path, const fs::path& out, const PlanInputs
   return result;
 }
 
+MapMesh mesh_map_tiles(const fs::path& map_path, const fs::path& out, const PlanInputs& plan,
+                       bool quiet) {
+  MapMesh result;
+  storage::StoreSettings store_settings;
+  store_settings.cache_bytes = std::size_t{128} << 20;
+  storage::Hdf5ChunkStore store(map_path, store_settings);
+  if (store.keys().empty()) return result;
+  viewer_export::TileSetSettings settings;
+  settings.overview_triangles = kOverviewTriangles;
+  viewer_export::TileSetReport report;
+  result.tiles =
+      write_tile_set_with_progress(store, (out / "tiles").string(), settings, quiet, &report);
+  result.stats.chunks = report.chunks;
+  result.stats.triangles = report.triangles;
+  result.stats.vertices = report.vertices;
+  result.stats.seconds = report.meshing_seconds;
+  result.mesh = std::move(report.overview);
+  result.overview_level = report.overview_level;
+  if (result.mesh.triangles.empty()) return result;
+  const Clock::time_point start = Clock::now();
+  result.plan = viewer_export::write_plan_view_png(result.mesh, plan.paths,
+                                                   (out / "topdown.png").string(), plan.settings);
+  result.write_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
 nlohmann::json mesh_json(const MapMesh& result) {
   const double s = result.stats.seconds;
   nlohmann::json json = {
@@ -65,6 +92,10 @@ nlohmann::json mesh_json(const MapMesh& result) {
       {"triangles_per_s", s > 0.0 ? static_cast<double>(result.stats.triangles) / s : 0.0},
       {"write_s", result.write_s}};
   if (result.plan) json["plan"] = plan_json(*result.plan, "topdown.png");
+  if (result.tiles) {
+    json["tiles"] = *result.tiles;
+    json["overview_level"] = result.overview_level;
+  }
   return json;
 }
 

@@ -18,10 +18,13 @@
 namespace featsense::app {
 
 struct MapMesh {
+  /// The whole map's mesh; with tiles, the tile set's overview (a coarser level, or none).
   mesh::TriangleMesh mesh;
   mesh::MeshingStats stats;
   std::optional<viewer_export::PlanView> plan;  ///< what topdown.png shows
   double write_s = 0.0;
+  std::optional<nlohmann::json> tiles;  ///< the tile set's figures (mesh_tile_set.hpp)
+  int overview_level = -1;              ///< the tile set's level that `mesh` is
 };
 
 /// What the plan view draws besides the mesh: the paths in the map frame, and its settings
@@ -42,6 +45,11 @@ viewer_export::PlanPath plan_path(const slam::Trajectory& trajectory,
 /// view: the map cut below its ceilings, seen from above, with `plan`'s paths).
 MapMesh mesh_map(const std::filesystem::path& map_path, const std::filesystem::path& out,
                  const PlanInputs& plan);
+/// The map as a tile set in `out`/tiles (viewer_export/tile_set.hpp), memory bounded by a
+/// tile; topdown.png from the finest level of at most kOverviewTriangles.
+MapMesh mesh_map_tiles(const std::filesystem::path& map_path, const std::filesystem::path& out,
+                       const PlanInputs& plan, bool quiet);
+inline constexpr std::size_t kOverviewTriangles = 4'000'000;
 nlohmann::json mesh_json(const MapMesh& result);
 
 /// The report's account of a plan view written to `file`: its size, its pixels and grid, and

@@ -9,14 +9,13 @@ namespace featsense::app {
 
 nlohmann::json write_tile_set_with_progress(storage::ChunkStore& store, const std::string& dir,
                                             const viewer_export::TileSetSettings& settings,
-                                            bool quiet) {
+                                            bool quiet, viewer_export::TileSetReport* whole) {
   viewer_export::TileSetSettings with_progress = settings;
   Progress progress("tiles", std::nullopt, quiet);
   with_progress.progress = [&](std::size_t done, std::size_t total) {
     progress.update(done, "of " + std::to_string(total));
   };
-  const viewer_export::TileSetReport report =
-      viewer_export::write_tile_set(store, dir, with_progress);
+  viewer_export::TileSetReport report = viewer_export::write_tile_set(store, dir, with_progress);
   progress.finish();
 
   nlohmann::json levels = nlohmann::json::array();
@@ -48,6 +47,7 @@ nlohmann::json write_tile_set_with_progress(storage::ChunkStore& store, const st
         report.levels.size(), report.seconds, report.meshing_seconds, report.simplifying_seconds,
         report.writing_seconds);
   }
+  if (whole != nullptr) *whole = std::move(report);
   return figures;
 }
 

@@ -11,9 +11,11 @@
 
 namespace featsense::app {
 
-/// Writes the tile set, prints its summary (unless quiet) and returns its figures.
+/// Writes the tile set, prints its summary (unless quiet) and returns its figures; the whole
+/// report goes to `report` where given.
 nlohmann::json write_tile_set_with_progress(storage::ChunkStore& store, const std::string& dir,
                                             const viewer_export::TileSetSettings& settings,
-                                            bool quiet);
+                                            bool quiet,
+                                            viewer_export::TileSetReport* report = nullptr);
 
 }  // namespace featsense::app

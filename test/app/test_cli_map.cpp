@@ -85,6 +85,25 @@ TEST_F(CliMap, WritesTheMapThePosesAndTheReport) {
   EXPECT_GT(store.keys().size(), 4u);
 }
 
+TEST_F(CliMap, WithTilesTheMeshIsATileSetAndThePlanComesFromItsOverview) {
+  const fs::path out = scratch_dir("cli_map_tiles");
+  const CommandResult run = run_featsense("map " + sequence() + " -o " + out.string() + " --gt " +
+                                          gt() + " --tiles" + kSmallMap);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* name : {"tiles/tileset.json", "tiles/tiles.json", "topdown.png"})
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  EXPECT_FALSE(fs::exists(out / "mesh.ply")) << "no single mesh with --tiles";
+  const nlohmann::json report = read_json(out / "report.json");
+  const nlohmann::json& mesh = report["mesh"];
+  EXPECT_GT(mesh["tiles"]["tiles"].get<size_t>(), 0u);
+  EXPECT_EQ(mesh["triangles"], mesh["tiles"]["triangles"]);
+  // The small lab fits the overview's budget at full resolution.
+  EXPECT_EQ(mesh["overview_level"], 0);
+  EXPECT_TRUE(mesh.contains("plan"));
+  EXPECT_FALSE(report.contains("eval") && report["eval"].contains("mesh"))
+      << "the overview is not compared with the truth";
+}
+
 /// Every chunk of two stores is equal, and they hold the same keys.
 void expect_same_maps(const fs::path& a, const fs::path& b) {
   storage::Hdf5ChunkStore first(a);

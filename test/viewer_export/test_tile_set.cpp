@@ -127,6 +127,29 @@ TEST(TileSet, TilesetKeepsTheRulesAndTheTilesHoldTheWholeMesh) {
   expect_valid((dir / "tiles/0/0_0.glb").string());
 }
 
+TEST(TileSet, TheOverviewIsTheFinestLevelWithinItsBudget) {
+  storage::MemoryChunkStore store = tile_scene_store();
+  const size_t whole = mesh::extract_mesh(store, {}).triangles.size();
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;
+  settings.write_ply = false;
+  settings.overview_triangles = whole;
+  viewer_export::TileSetReport report =
+      viewer_export::write_tile_set(store, scratch_dir("overview_a").string(), settings);
+  EXPECT_EQ(report.overview_level, 0);
+  EXPECT_EQ(report.overview.triangles.size(), whole);
+
+  settings.overview_triangles = report.levels[1].triangles;
+  report = viewer_export::write_tile_set(store, scratch_dir("overview_b").string(), settings);
+  EXPECT_EQ(report.overview_level, 1);
+  EXPECT_EQ(report.overview.triangles.size(), report.levels[1].triangles);
+
+  settings.overview_triangles = 10;
+  report = viewer_export::write_tile_set(store, scratch_dir("overview_c").string(), settings);
+  EXPECT_EQ(report.overview_level, -1);
+  EXPECT_TRUE(report.overview.triangles.empty());
+}
+
 TEST(TileSet, OneTileIsItsOwnRootAndBadInputIsRefused) {
   // Tiles start at the map's origin: a floor inside the first chunk is one tile.
   storage::MemoryChunkStore store(test_metadata(kTileSceneVoxel, kTileSceneTau));

@@ -92,6 +92,7 @@ class TileSetBuilder {
     std::optional<Built> root = build_node(top, root_index.first, root_index.second);
     if (!root) throw std::runtime_error("the map has no surface to mesh");
     report_.root = std::move(root->node);
+    pick_overview();
     const auto writing = Clock::now();
     write_text(dir_ / "tileset.json", tileset_json(report_.root));
     write_index();
@@ -148,6 +149,7 @@ class TileSetBuilder {
     built.node.triangles = full.triangles.size();
     built.node.content = content_path(0, x, y, ".glb");
     write_content(built.node.content, full);
+    collect_for_overview(0, full);
     if (settings_.write_ply) {
       start = Clock::now();
       write_ply_mesh((dir_ / content_path(0, x, y, ".ply")).string(), full);
@@ -199,6 +201,7 @@ class TileSetBuilder {
     built.node.triangles = content.triangles.size();
     built.node.content = content_path(level, x, y, ".glb");
     write_content(built.node.content, content);
+    collect_for_overview(level, content);
     count(built.node);
     simplify_for_parent(content, level, x, y, built);
     return built;
@@ -230,6 +233,35 @@ class TileSetBuilder {
     built.for_parent = std::move(simplified.mesh);
     built.for_parent_error_m = simplified.error_m;
     report_.simplifying_seconds += seconds_since(start);
+  }
+
+  /// Keeps a copy of a level's content while the level's tiles fit the overview's budget.
+  void collect_for_overview(int level, const mesh::TriangleMesh& content) {
+    if (settings_.overview_triangles == 0) return;
+    if (overview_parts_.size() <= static_cast<std::size_t>(level))
+      overview_parts_.resize(static_cast<std::size_t>(level) + 1);
+    LevelParts& parts = overview_parts_[static_cast<std::size_t>(level)];
+    if (parts.over_budget) return;
+    parts.triangles += content.triangles.size();
+    if (parts.triangles > settings_.overview_triangles) {
+      parts.over_budget = true;
+      parts.meshes.clear();
+      return;
+    }
+    parts.meshes.push_back(content);
+  }
+
+  void pick_overview() {
+    for (std::size_t level = 0; level < overview_parts_.size(); ++level) {
+      LevelParts& parts = overview_parts_[level];
+      if (parts.over_budget || parts.meshes.empty()) continue;
+      std::vector<const mesh::TriangleMesh*> pointers;
+      for (const mesh::TriangleMesh& part : parts.meshes) pointers.push_back(&part);
+      report_.overview = mesh::weld_by_position(pointers);
+      report_.overview_level = static_cast<int>(level);
+      break;
+    }
+    overview_parts_.clear();
   }
 
   void write_content(const std::string& relative, const mesh::TriangleMesh& content) {
@@ -290,6 +322,13 @@ class TileSetBuilder {
   std::set<std::pair<int32_t, int32_t>> leaves_;  ///< quadtree coordinates of the tiles
   std::vector<std::set<std::pair<int32_t, int32_t>>> present_;  ///< nodes per level
   std::size_t leaves_done_ = 0;
+  /// Each level's contents while they fit the overview's budget.
+  struct LevelParts {
+    std::vector<mesh::TriangleMesh> meshes;
+    std::size_t triangles = 0;
+    bool over_budget = false;
+  };
+  std::vector<LevelParts> overview_parts_;
   TileSetReport report_;
 };
 

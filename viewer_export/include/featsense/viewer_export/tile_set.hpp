@@ -40,6 +40,9 @@ struct TileSetSettings {
   /// parent's edge: fewer triangles than level_ratio are kept where the surface allows, more
   /// where it does not (thin structure, many open borders), never a collapse that distorts it.
   double max_error_share = 0.001;
+  /// Where > 0: the report's `overview` is the whole map at the finest level whose tiles hold
+  /// at most this many triangles together (for a plan view of a map too large to mesh whole).
+  std::size_t overview_triangles = 0;
   /// Called after each full-resolution tile: tiles done, tiles in all.
   std::function<void(std::size_t, std::size_t)> progress;
 };
@@ -77,6 +80,10 @@ struct TileSetReport {
   double writing_seconds = 0.0;
   double seconds = 0.0;
   TileSetNode root;
+  /// With overview_triangles: the finest level within the budget, its tiles welded; -1 and
+  /// empty when even the root holds more.
+  int overview_level = -1;
+  mesh::TriangleMesh overview;
 };
 
 /// Meshes `store` tile by tile into `dir` (created; files already there are overwritten).
