@@ -127,6 +127,29 @@ TEST(TileSet, TilesetKeepsTheRulesAndTheTilesHoldTheWholeMesh) {
   expect_valid((dir / "tiles/0/0_0.glb").string());
 }
 
+TEST(TileSet, LevelsAreAddedAboveTheRootUntilItIsSmallEnough) {
+  storage::MemoryChunkStore store = tile_scene_store();
+  const fs::path dir = scratch_dir("tile_set_small_root");
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;
+  settings.write_ply = false;
+  settings.root_triangles = 1000;
+  const viewer_export::TileSetReport report =
+      viewer_export::write_tile_set(store, dir.string(), settings);
+  ASSERT_GT(report.levels.size(), 3u) << "the quadtree alone has three levels";
+  EXPECT_EQ(report.levels.back().tiles, 1u);
+  EXPECT_LE(report.root.triangles, 1000u);
+  EXPECT_EQ(report.root.level + 1, static_cast<int>(report.levels.size()));
+  nlohmann::json tileset;
+  std::ifstream(dir / "tileset.json") >> tileset;
+  Walk walk{dir};
+  check_tile(tileset["root"],
+             Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-1e9), Eigen::Vector3d::Constant(1e9)),
+             tileset["geometricError"].get<double>(), 0, walk);
+  EXPECT_EQ(walk.leaves, 16u);
+  EXPECT_EQ(walk.deepest, report.root.level);
+}
+
 TEST(TileSet, TheOverviewIsTheFinestLevelWithinItsBudget) {
   storage::MemoryChunkStore store = tile_scene_store();
   const size_t whole = mesh::extract_mesh(store, {}).triangles.size();

@@ -91,6 +91,17 @@ class TileSetBuilder {
     const auto& root_index = *present_.back().begin();
     std::optional<Built> root = build_node(top, root_index.first, root_index.second);
     if (!root) throw std::runtime_error("the map has no surface to mesh");
+    // A viewer loads the root first: levels above it, each a quarter of the one below, until
+    // it is small enough (or simplifying no longer makes it smaller).
+    for (int level = top + 1; level < 31 && root->node.triangles > settings_.root_triangles &&
+                              root->for_parent.triangles.size() * 10 < root->node.triangles * 9;
+         ++level) {
+      std::vector<Built> only;
+      const int32_t x = root->node.level == 0 ? root_index.first : root->node.x;
+      const int32_t y = root->node.level == 0 ? root_index.second : root->node.y;
+      only.push_back(std::move(*root));
+      root = make_parent(level, x >> 1, y >> 1, std::move(only));
+    }
     report_.root = std::move(root->node);
     pick_overview();
     const auto writing = Clock::now();
@@ -171,7 +182,11 @@ class TileSetBuilder {
         if (child) children.push_back(std::move(*child));
       }
     if (children.empty()) return std::nullopt;
+    return make_parent(level, x, y, std::move(children));
+  }
 
+  /// Node (x, y) at `level` over its children (built, with their shares for it).
+  Built make_parent(int level, int32_t x, int32_t y, std::vector<Built> children) {
     Built built;
     built.node.level = level;
     built.node.x = x;
@@ -273,6 +288,10 @@ class TileSetBuilder {
   }
 
   void count(const TileSetNode& node) {
+    if (report_.levels.size() <= static_cast<std::size_t>(node.level)) {
+      report_.levels.resize(static_cast<std::size_t>(node.level) + 1);
+      report_.levels.back().level = node.level;
+    }
     TileSetLevel& level = report_.levels[static_cast<std::size_t>(node.level)];
     level.tiles += 1;
     level.triangles += node.triangles;

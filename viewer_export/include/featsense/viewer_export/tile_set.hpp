@@ -40,6 +40,9 @@ struct TileSetSettings {
   /// parent's edge: fewer triangles than level_ratio are kept where the surface allows, more
   /// where it does not (thin structure, many open borders), never a collapse that distorts it.
   double max_error_share = 0.001;
+  /// A viewer loads the root first: levels are added above the quadtree's root, each a quarter
+  /// of the one below, until the root holds at most this many triangles.
+  std::size_t root_triangles = 200'000;
   /// Where > 0: the report's `overview` is the whole map at the finest level whose tiles hold
   /// at most this many triangles together (for a plan view of a map too large to mesh whole).
   std::size_t overview_triangles = 0;
