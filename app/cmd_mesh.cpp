@@ -130,11 +130,11 @@ void check_tile_options(const MeshOptions& options) {
     throw config::ConfigError("--tile-size: must be a positive number of metres, got " +
                               std::to_string(options.tile_size_m));
   }
-  if (options.output.empty() && (options.clean || options.simplify_ratio < 1.0 ||
-                                 options.check_self_intersections || options.plan_path)) {
+  if (options.output.empty() &&
+      (options.simplify_ratio < 1.0 || options.check_self_intersections || options.plan_path)) {
     throw config::ConfigError(
-        "--clean, --simplify, --check-self-intersections and --plan work on one mesh: give -o "
-        "FILE with --tiles (the tiles themselves are not cleaned)");
+        "--simplify, --check-self-intersections and --plan work on one mesh: give -o FILE with "
+        "--tiles (the tile set has its own coarser levels; --clean cleans each tile)");
   }
 }
 
@@ -261,6 +261,13 @@ void run_mesh(const MeshOptions& options) {
     tiling.tile_size_m = options.tile_size_m;
     tiling.meshing = run.settings;
     tiling.write_ply = options.tile_ply;
+    if (options.clean) {
+      mesh::CleanupSettings cleaning;
+      cleaning.min_component_area_m2 = options.min_component_area_m2;
+      cleaning.max_hole_perimeter_m = options.max_hole_perimeter_m;
+      cleaning.check_self_intersections = false;
+      tiling.cleanup = cleaning;
+    }
     tiles = write_tile_set_with_progress(*store, *options.tiles_dir, tiling, options.quiet);
     if (options.output.empty()) {
       if (options.json_path)
@@ -338,7 +345,7 @@ Command register_mesh(CLI::App& app, const CliContext& context) {
       ->capture_default_str();
   command->add_flag("--clean", options->clean,
                     "Remove small components (--min-component-area), split non-manifold "
-                    "vertices, fill holes (--max-hole)");
+                    "vertices, fill holes (--max-hole); with --tiles each tile, its cuts held");
   command
       ->add_option("--min-component-area", options->min_component_area_m2,
                    "With --clean: smaller components are removed, square metres")

@@ -25,20 +25,33 @@ nlohmann::json write_tile_set_with_progress(storage::ChunkStore& store, const st
                       {"triangles", level.triangles},
                       {"max_geometric_error_m", level.max_geometric_error_m}});
   }
-  const nlohmann::json figures = {{"dir", dir},
-                                  {"tileset", dir + "/tileset.json"},
-                                  {"index", dir + "/tiles.json"},
-                                  {"tile_size_m", report.tile_size_m},
-                                  {"tiles", report.tiles},
-                                  {"triangles", report.triangles},
-                                  {"vertices", report.vertices},
-                                  {"chunks", report.chunks},
-                                  {"levels", levels},
-                                  {"meshing_s", report.meshing_seconds},
-                                  {"simplifying_s", report.simplifying_seconds},
-                                  {"writing_s", report.writing_seconds},
-                                  {"seconds", report.seconds},
-                                  {"peak_rss_mb", bench::peak_rss_mb()}};
+  nlohmann::json figures = {{"dir", dir},
+                            {"tileset", dir + "/tileset.json"},
+                            {"index", dir + "/tiles.json"},
+                            {"tile_size_m", report.tile_size_m},
+                            {"tiles", report.tiles},
+                            {"triangles", report.triangles},
+                            {"vertices", report.vertices},
+                            {"chunks", report.chunks},
+                            {"levels", levels},
+                            {"meshing_s", report.meshing_seconds},
+                            {"simplifying_s", report.simplifying_seconds},
+                            {"writing_s", report.writing_seconds},
+                            {"seconds", report.seconds},
+                            {"peak_rss_mb", bench::peak_rss_mb()}};
+  if (report.cleanup) {
+    const mesh::CleanupReport& c = *report.cleanup;
+    figures["cleanup"] = {{"input_triangles", c.input_triangles},
+                          {"output_triangles", c.output_triangles},
+                          {"removed_components", c.removed_components},
+                          {"removed_component_triangles", c.removed_component_triangles},
+                          {"components_kept_on_cuts", c.components_kept_on_cuts},
+                          {"non_manifold_vertices_fixed", c.non_manifold_vertices_fixed},
+                          {"holes_filled", c.holes_filled},
+                          {"holes_left", c.holes_left},
+                          {"borders_on_cuts", c.borders_on_cuts},
+                          {"seconds", c.seconds}};
+  }
   if (!quiet) {
     std::printf(
         "%s: %zu tiles of %.1f m, %zu triangles from %zu chunks, %zu levels, in %.1f s "

@@ -96,6 +96,15 @@ SurfaceMesh to_surface_mesh(const TriangleMesh& mesh, const CleanupSettings& set
   return out;
 }
 
+/// Whether a vertex lies on a cut of the larger mesh (CleanupSettings::on_cut).
+bool on_cut(const SurfaceMesh& mesh, SurfaceMesh::Vertex_index v, const CleanupSettings& settings) {
+  if (!settings.on_cut) return false;
+  const Point& p = mesh.point(v);
+  // The points came from floats: back to them exactly.
+  return settings.on_cut(Eigen::Vector3f(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                         static_cast<float>(p.z())));
+}
+
 /// Removes the components below the settings' size; returns how many.
 void remove_small_components(SurfaceMesh& mesh, const CleanupSettings& settings,
                              CleanupReport& report) {
@@ -104,14 +113,21 @@ void remove_small_components(SurfaceMesh& mesh, const CleanupSettings& settings,
   const std::size_t count = PMP::connected_components(mesh, component);
   std::vector<double> area(count, 0.0);
   std::vector<std::size_t> triangles(count, 0);
+  std::vector<bool> reaches_cut(count, false);
   for (const Face f : mesh.faces()) {
     area[component[f]] += PMP::face_area(f, mesh);
     ++triangles[component[f]];
+    if (settings.on_cut && !reaches_cut[component[f]]) {
+      for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+        if (on_cut(mesh, v, settings)) reaches_cut[component[f]] = true;
+    }
   }
   std::vector<std::size_t> small;
   for (std::size_t c = 0; c < count; ++c) {
-    if (area[c] < settings.min_component_area_m2 ||
-        triangles[c] < settings.min_component_triangles) {
+    const bool is_small =
+        area[c] < settings.min_component_area_m2 || triangles[c] < settings.min_component_triangles;
+    if (is_small && reaches_cut[c]) ++report.components_kept_on_cuts;
+    if (is_small && !reaches_cut[c]) {
       small.push_back(c);
       report.removed_component_triangles += triangles[c];
     }
@@ -135,6 +151,13 @@ void fill_holes(SurfaceMesh& mesh, const CleanupSettings& settings, CleanupRepor
   std::vector<Halfedge> borders;
   PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
   for (const Halfedge border : borders) {
+    bool passes_cut = false;
+    for (const Halfedge h : CGAL::halfedges_around_face(border, mesh))
+      passes_cut = passes_cut || on_cut(mesh, mesh.target(h), settings);
+    if (passes_cut) {
+      ++report.borders_on_cuts;
+      continue;
+    }
     if (settings.max_hole_perimeter_m <= 0.0 ||
         border_length(border, mesh) > settings.max_hole_perimeter_m) {
       ++report.holes_left;

@@ -5,9 +5,12 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <map>
+#include <vector>
 
 #include "common/run_command.hpp"
 #include "common/test_data.hpp"
+#include "featsense/mesh/mesh_simplification.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/storage/vdb_io.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
@@ -130,6 +133,29 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "t" / "tileset.json"));
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "t" / "tiles" / "0" / "-1_-1.ply"));
 
+  // Cleaned tile by tile, the cuts held: the four quarters still weld into a closed ball.
+  result = run_featsense("mesh " + map + " --tiles " + (dir / "c").string() +
+                         " --tile-size 3 --clean --json " + json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream(json) >> figures;
+  const nlohmann::json& cleanup = figures["tiles"]["cleanup"];
+  EXPECT_EQ(cleanup["holes_filled"], 0) << cleanup;
+  EXPECT_EQ(cleanup["borders_on_cuts"], 4) << cleanup;
+  std::vector<mesh::TriangleMesh> quarters;
+  for (const char* name : {"-1_-1", "-1_0", "0_-1", "0_0"})
+    quarters.push_back(viewer_export::read_mesh(
+        (dir / "c" / "tiles" / "0" / (std::string(name) + ".ply")).string()));
+  std::vector<const mesh::TriangleMesh*> parts;
+  for (const mesh::TriangleMesh& q : quarters) parts.push_back(&q);
+  const mesh::TriangleMesh ball = mesh::weld_by_position(parts);
+  std::map<std::pair<int, int>, int> edge_uses;
+  for (const Eigen::Vector3i& t : ball.triangles)
+    for (int k = 0; k < 3; ++k)
+      ++edge_uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+  size_t border = 0;
+  for (const auto& [edge, uses] : edge_uses) border += uses == 1 ? 1 : 0;
+  EXPECT_EQ(border, 0u) << "the cleaned tiles do not meet";
+
   // Tiles alone, quietly, GLB only.
   result = run_featsense("--quiet mesh " + map + " --tiles " + (dir / "q").string() +
                          " --tile-size 3 --no-tile-ply");
@@ -172,7 +198,7 @@ TEST(CliMesh, ErrorsAreClear) {
       {"mesh " + map, "give -o MESH (one mesh), --tiles DIR (a tile set), or both"},
       {"mesh " + map + " --tiles " + (dir / "t").string() + " --tile-size 0",
        "--tile-size: must be a positive number of metres"},
-      {"mesh " + map + " --tiles " + (dir / "t").string() + " --clean", "work on one mesh"},
+      {"mesh " + map + " --tiles " + (dir / "t").string() + " --simplify 0.5", "work on one mesh"},
   };
   for (const Case& c : cases) {
     const CommandResult result = run_featsense(c.args);

@@ -152,6 +152,40 @@ TEST(MeshCleanup, SimplifiedSphereStaysClosedWithABoundedError) {
   ASSERT_TRUE(sphere.has_normals());
 }
 
+TEST(MeshCleanup, APieceCleanedApartKeepsWhatReachesItsCutAndLeavesTheCutOpen) {
+  // A tile of a floor, cut at x = 1 from its neighbour: a hole in its middle, a speck of noise
+  // inside it and one that reaches the cut (its rest lies in the neighbour).
+  mesh::TriangleMesh tile = grid_plane(0, 1, 0, 1, 0, 20);
+  std::vector<Eigen::Vector3i> kept;
+  for (const Eigen::Vector3i& t : tile.triangles) {
+    const Eigen::Vector3f c =
+        (tile.vertices[static_cast<size_t>(t[0])] + tile.vertices[static_cast<size_t>(t[1])] +
+         tile.vertices[static_cast<size_t>(t[2])]) /
+        3.0f;
+    if ((c - Eigen::Vector3f(0.5f, 0.5f, 0)).norm() > 0.08f) kept.push_back(t);
+  }
+  tile.triangles = kept;
+  append(tile, grid_plane(0, 0.05f, 0, 0.05f, 0.5f, 1), {0.4f, 0.4f, 0});   // inside
+  append(tile, grid_plane(0, 0.05f, 0, 0.05f, 0.5f, 1), {0.95f, 0.4f, 0});  // at the cut
+  mesh::CleanupSettings settings = no_self_intersection_check();
+  settings.min_component_area_m2 = 0.01;
+  settings.max_hole_perimeter_m = 1.0;
+
+  mesh::TriangleMesh whole_rules = tile;
+  mesh::CleanupReport report = mesh::clean_mesh(whole_rules, settings);
+  EXPECT_EQ(report.removed_components, 2u) << "without a cut both specks are noise";
+
+  settings.on_cut = [](const Eigen::Vector3f& p) { return p.x() == 1.0f; };
+  report = mesh::clean_mesh(tile, settings);
+  EXPECT_EQ(report.removed_components, 1u);
+  EXPECT_EQ(report.components_kept_on_cuts, 1u);
+  EXPECT_EQ(report.holes_filled, 1u);
+  EXPECT_EQ(report.borders_on_cuts, 2u) << "the floor's edge and the speck's pass the cut";
+  size_t on_cut = 0;
+  for (const Eigen::Vector3f& v : tile.vertices) on_cut += v.x() == 1.0f ? 1 : 0;
+  EXPECT_EQ(on_cut, 21u + 2u) << "the cut's vertices stay for the neighbour to meet";
+}
+
 TEST(MeshCleanup, RejectsBadSettings) {
   mesh::TriangleMesh cube = box_mesh(0.5f);
   mesh::CleanupSettings settings;

@@ -72,6 +72,7 @@ class TileSetBuilder {
     for (const mesh::TileIndex& tile : tiles)
       leaves_.insert({tile.x - origin_.x, tile.y - origin_.y});
     report_.tile_size_m = tiles_.tile_size_m();
+    if (settings_.cleanup) report_.cleanup.emplace();
   }
 
   TileSetReport build() {
@@ -150,6 +151,8 @@ class TileSetBuilder {
     report_.chunks += stats.chunks;
     ++leaves_done_;
     if (settings_.progress) settings_.progress(leaves_done_, leaves_.size());
+    if (full.triangles.empty()) return std::nullopt;
+    if (settings_.cleanup) clean_tile(full, qx, qy);
     if (full.triangles.empty()) return std::nullopt;
 
     Built built;
@@ -248,6 +251,35 @@ class TileSetBuilder {
     built.for_parent = std::move(simplified.mesh);
     built.for_parent_error_m = simplified.error_m;
     report_.simplifying_seconds += seconds_since(start);
+  }
+
+  /// The tile's cleanup with its four cuts held; its report added to the set's.
+  void clean_tile(mesh::TriangleMesh& full, int32_t qx, int32_t qy) {
+    const float x0 = static_cast<float>(tiles_.cut_m(qx + origin_.x));
+    const float x1 = static_cast<float>(tiles_.cut_m(qx + 1 + origin_.x));
+    const float y0 = static_cast<float>(tiles_.cut_m(qy + origin_.y));
+    const float y1 = static_cast<float>(tiles_.cut_m(qy + 1 + origin_.y));
+    mesh::CleanupSettings cleanup = *settings_.cleanup;
+    cleanup.on_cut = [=](const Eigen::Vector3f& p) {
+      return p.x() == x0 || p.x() == x1 || p.y() == y0 || p.y() == y1;
+    };
+    const mesh::CleanupReport tile = mesh::clean_mesh(full, cleanup);
+    mesh::CleanupReport& sum = *report_.cleanup;
+    sum.input_vertices += tile.input_vertices;
+    sum.input_triangles += tile.input_triangles;
+    sum.output_vertices += tile.output_vertices;
+    sum.output_triangles += tile.output_triangles;
+    sum.degenerate_triangles_removed += tile.degenerate_triangles_removed;
+    sum.removed_components += tile.removed_components;
+    sum.removed_component_triangles += tile.removed_component_triangles;
+    sum.non_manifold_vertices_fixed += tile.non_manifold_vertices_fixed;
+    sum.holes_filled += tile.holes_filled;
+    sum.holes_left += tile.holes_left;
+    sum.borders_on_cuts += tile.borders_on_cuts;
+    sum.components_kept_on_cuts += tile.components_kept_on_cuts;
+    sum.border_edges += tile.border_edges;
+    sum.self_intersections += tile.self_intersections;
+    sum.seconds += tile.seconds;
   }
 
   /// Keeps a copy of a level's content while the level's tiles fit the overview's budget.

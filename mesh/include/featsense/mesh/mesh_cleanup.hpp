@@ -4,6 +4,7 @@
 /// up to a size filled, and an optional simplification whose error is measured.
 
 #include <cstddef>
+#include <functional>
 
 #include "featsense/mesh/triangle_mesh.hpp"
 
@@ -24,6 +25,11 @@ struct CleanupSettings {
   double simplify_ratio = 1.0;
   /// Count self-intersecting triangle pairs of the result (costs about as much as the rest).
   bool check_self_intersections = true;
+  /// Where given: true for a point on a cut of a larger mesh that this one is a piece of (a
+  /// tile's border). A component that reaches a cut is kept whatever its size, since the rest
+  /// of it lies beyond; a border that passes a cut is not a hole, it is the cut; and cut edges
+  /// are borders, which simplification keeps in place. So pieces cleaned apart still meet.
+  std::function<bool(const Eigen::Vector3f&)> on_cut;
 };
 
 struct CleanupReport {
@@ -36,7 +42,9 @@ struct CleanupReport {
   std::size_t removed_component_triangles = 0;
   std::size_t non_manifold_vertices_fixed = 0;  ///< vertices split (also at non-manifold edges)
   std::size_t holes_filled = 0;
-  std::size_t holes_left = 0;  ///< borders longer than the limit (or not fillable)
+  std::size_t holes_left = 0;               ///< borders longer than the limit (or not fillable)
+  std::size_t borders_on_cuts = 0;          ///< borders left alone since they pass a cut
+  std::size_t components_kept_on_cuts = 0;  ///< small, but reaching a cut
   /// Distance between the simplified surface and the mesh before simplification, both ways
   /// (vertices and surface samples), metres; 0 without simplification.
   double simplification_max_error_m = 0.0;

@@ -23,10 +23,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "featsense/mesh/marching_cubes.hpp"
+#include "featsense/mesh/mesh_cleanup.hpp"
 #include "featsense/storage/chunk_store.hpp"
 
 namespace featsense::viewer_export {
@@ -35,7 +37,10 @@ struct TileSetSettings {
   double tile_size_m = 50.0;      ///< rounded to whole chunks (mesh::chunks_per_tile_for)
   mesh::MeshingSettings meshing;  ///< min weight, bbox, threads of the marching cubes
   bool write_ply = true;          ///< each full-resolution tile also as PLY
-  double level_ratio = 0.25;      ///< share of a child's triangles its parent keeps
+  /// Where given, each full-resolution tile is cleaned before it is written (mesh_cleanup.hpp),
+  /// its cuts held: what reaches a cut is kept and a cut is not a hole, so tiles still meet.
+  std::optional<mesh::CleanupSettings> cleanup;
+  double level_ratio = 0.25;  ///< share of a child's triangles its parent keeps
   /// A child simplified for its parent moves the surface by at most this share of the
   /// parent's edge: fewer triangles than level_ratio are kept where the surface allows, more
   /// where it does not (thin structure, many open borders), never a collapse that distorts it.
@@ -78,6 +83,8 @@ struct TileSetReport {
   std::size_t vertices = 0;          ///< of the full-resolution tiles (border ones twice)
   std::size_t chunks = 0;            ///< meshed
   std::vector<TileSetLevel> levels;  ///< finest first
+  /// With cleanup: the tiles' reports summed (counts and seconds; is_* not meaningful).
+  std::optional<mesh::CleanupReport> cleanup;
   double meshing_seconds = 0.0;
   double simplifying_seconds = 0.0;
   double writing_seconds = 0.0;
