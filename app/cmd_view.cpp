@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -32,9 +33,10 @@ void run_view(const ViewOptions& options, const CliContext& context) {
   const Clock::time_point start = Clock::now();
   std::unique_ptr<ViewServer> server_owner;
   std::string loaded;
-  if (is_tile_set_folder(options.folder)) {
-    TileSetSite site = load_tile_set_site(options.folder, options.web_modules);
-    loaded = "tile set " + options.folder + " (" + std::to_string(site.tiles) + " tiles)";
+  if (const std::optional<std::filesystem::path> tiles = tile_set_to_view(options.folder)) {
+    TileSetSite site = load_tile_set_site(*tiles, options.web_modules);
+    loaded = "tile set " + tiles->string() + " (" + std::to_string(site.tiles) +
+             " tiles of every level)";
     server_owner = std::make_unique<ViewServer>(std::move(site));
   } else {
     loaded = options.folder;

@@ -35,6 +35,15 @@ bool is_tile_set_folder(const fs::path& folder) {
   return fs::is_regular_file(folder / "tileset.json", error);
 }
 
+std::optional<fs::path> tile_set_to_view(const fs::path& folder) {
+  if (is_tile_set_folder(folder)) return folder;
+  std::error_code error;
+  const bool has_mesh =
+      fs::exists(folder / "mesh.ply", error) || fs::exists(folder / "mesh.glb", error);
+  if (!has_mesh && is_tile_set_folder(folder / "tiles")) return folder / "tiles";
+  return std::nullopt;
+}
+
 TileSetSite load_tile_set_site(const fs::path& folder, const fs::path& modules_folder) {
   TileSetSite site;
   site.folder = folder;

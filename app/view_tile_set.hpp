@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 
 namespace featsense::app {
@@ -20,11 +21,16 @@ struct TileSetSite {
   std::map<std::string, std::filesystem::path> tileset_files;
   /// Route under /modules/ ("three/build/three.module.js") -> file.
   std::map<std::string, std::filesystem::path> module_files;
-  std::size_t tiles = 0;  ///< GLB files
+  std::size_t tiles = 0;  ///< GLB files: the tiles of every level
 };
 
 /// True where `folder` holds a tileset.json.
 bool is_tile_set_folder(const std::filesystem::path& folder);
+
+/// The tile set `featsense view FOLDER` shows, if any: FOLDER itself where it holds a
+/// tileset.json, or FOLDER/tiles where FOLDER is the output of `featsense map --tiles` (a
+/// tiles/tileset.json and no mesh.ply or mesh.glb of its own).
+std::optional<std::filesystem::path> tile_set_to_view(const std::filesystem::path& folder);
 
 /// Lists the tile set's files and the modules; throws ViewError when the tileset or a module
 /// is missing (saying how to install the modules).

@@ -181,6 +181,19 @@ fs::path write_test_tile_set(const std::string& name) {
   return dir;
 }
 
+TEST(CliView, TheOutputOfMapWithTilesShowsItsTileSet) {
+  if (!web_modules_present()) GTEST_SKIP() << "no npm modules (scripts/install-web.sh)";
+  const fs::path out = scratch_dir("cli_view_map_tiles");
+  fs::rename(write_test_tile_set("cli_view_map_tiles_set"), out / "tiles");
+  std::ofstream(out / "report.json") << "{}";
+  ViewProcess view(out.string() + " --port 0");
+  const std::string loaded = view.first_line();
+  EXPECT_NE(loaded.find("tile set " + (out / "tiles").string() + " (21 tiles of every level)"),
+            std::string::npos)
+      << loaded;
+  EXPECT_EQ(view.stop(), 0);
+}
+
 TEST(CliView, ATileSetWithoutItsModulesIsOneClearError) {
   const fs::path dir = write_test_tile_set("cli_view_tiles_no_modules");
   expect_one_clear_error(
