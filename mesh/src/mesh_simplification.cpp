@@ -2,6 +2,7 @@
 
 #include <meshoptimizer.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -62,11 +63,16 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifySettings& s
   // scanned surface full of small holes. It also holds every vertex that shares its position
   // with a vertex no triangle uses (it cannot tell which side of such a seam is which), so a
   // held vertex gets such a twin after the mesh's own vertices; twins are never in the output.
-  std::vector<Eigen::Vector3f> positions_with_twins = mesh.vertices;
-  for (std::size_t v = 0; v < held.size(); ++v)
-    if (held[v]) positions_with_twins.push_back(mesh.vertices[v]);
-  const auto* positions = reinterpret_cast<const float*>(positions_with_twins.data());
-  const std::size_t vertex_count = positions_with_twins.size();
+  std::vector<Eigen::Vector3f> positions_with_twins;
+  const bool any_held = std::find(held.begin(), held.end(), true) != held.end();
+  if (any_held) {
+    positions_with_twins = mesh.vertices;
+    for (std::size_t v = 0; v < held.size(); ++v)
+      if (held[v]) positions_with_twins.push_back(mesh.vertices[v]);
+  }
+  const std::vector<Eigen::Vector3f>& with_twins = any_held ? positions_with_twins : mesh.vertices;
+  const auto* positions = reinterpret_cast<const float*>(with_twins.data());
+  const std::size_t vertex_count = with_twins.size();
   const float scale = meshopt_simplifyScale(positions, vertex_count, sizeof(Eigen::Vector3f));
   // meshoptimizer measures errors relative to the mesh's extent.
   const float relative_error =

@@ -60,7 +60,6 @@ class TileSetBuilder {
       : tiles_(store, mesh::chunks_per_tile_for(settings.tile_size_m, store.metadata())),
         dir_(dir),
         settings_(settings),
-        pad_m_(0.5 * store.metadata().voxel_size_m),
         voxel_m_(store.metadata().voxel_size_m) {
     const std::vector<mesh::TileIndex> tiles = tiles_.tiles();
     // The quadtree starts at the first tile, so that its coordinates are >= 0 and a map that
@@ -86,22 +85,21 @@ class TileSetBuilder {
       for (const auto& [x, y] : leaves_) nodes.insert({at_level(x, level), at_level(y, level)});
       present_.push_back(std::move(nodes));
     }
-    report_.levels.resize(static_cast<std::size_t>(top) + 1);
-    for (int level = 0; level <= top; ++level)
-      report_.levels[static_cast<std::size_t>(level)].level = level;
     const auto& root_index = *present_.back().begin();
     std::optional<Built> root = build_node(top, root_index.first, root_index.second);
     if (!root) throw std::runtime_error("the map has no surface to mesh");
     // A viewer loads the root first: levels above it, each a quarter of the one below, until
     // it is small enough (or simplifying no longer makes it smaller).
+    int32_t qx = root_index.first;
+    int32_t qy = root_index.second;
     for (int level = top + 1; level < 31 && root->node.triangles > settings_.root_triangles &&
                               root->for_parent.triangles.size() * 10 < root->node.triangles * 9;
          ++level) {
       std::vector<Built> only;
-      const int32_t x = root->node.level == 0 ? root_index.first : root->node.x;
-      const int32_t y = root->node.level == 0 ? root_index.second : root->node.y;
       only.push_back(std::move(*root));
-      root = make_parent(level, x >> 1, y >> 1, std::move(only));
+      qx >>= 1;
+      qy >>= 1;
+      root = make_parent(level, qx, qy, std::move(only));
     }
     report_.root = std::move(root->node);
     pick_overview();
@@ -159,7 +157,7 @@ class TileSetBuilder {
     built.node.level = 0;
     built.node.x = x;
     built.node.y = y;
-    built.node.box = padded_bounds(full, pad_m_);
+    built.node.box = padded_bounds(full, 0.5 * voxel_m_);
     built.node.triangles = full.triangles.size();
     built.node.content = content_path(0, x, y, ".glb");
     write_content(built.node.content, full);
@@ -231,18 +229,9 @@ class TileSetBuilder {
   void simplify_for_parent(const mesh::TriangleMesh& content, int level, int32_t qx, int32_t qy,
                            Built& built) {
     const auto start = Clock::now();
-    const auto cut = [&](int32_t q, int32_t origin) {
-      return static_cast<float>(tiles_.cut_m(q * (int32_t{1} << level) + origin));
-    };
-    const float x0 = cut(qx, origin_.x);
-    const float x1 = cut(qx + 1, origin_.x);
-    const float y0 = cut(qy, origin_.y);
-    const float y1 = cut(qy + 1, origin_.y);
+    const NodeCuts cuts = cuts_of(level, qx, qy);
     std::vector<bool> held(content.vertices.size());
-    for (std::size_t v = 0; v < held.size(); ++v) {
-      const Eigen::Vector3f& p = content.vertices[v];
-      held[v] = p.x() == x0 || p.x() == x1 || p.y() == y0 || p.y() == y1;
-    }
+    for (std::size_t v = 0; v < held.size(); ++v) held[v] = cuts.holds(content.vertices[v]);
     mesh::SimplifySettings simplify;
     simplify.target_ratio = settings_.level_ratio;
     const double parent_edge_m = report_.tile_size_m * static_cast<double>(int64_t{2} << level);
@@ -253,16 +242,27 @@ class TileSetBuilder {
     report_.simplifying_seconds += seconds_since(start);
   }
 
+  /// The four lines where node (qx, qy) at `level` meets its neighbours, as the floats its
+  /// vertices on them have (MapTiles::cut_m).
+  struct NodeCuts {
+    float x0, x1, y0, y1;
+    bool holds(const Eigen::Vector3f& p) const {
+      return p.x() == x0 || p.x() == x1 || p.y() == y0 || p.y() == y1;
+    }
+  };
+
+  NodeCuts cuts_of(int level, int32_t qx, int32_t qy) const {
+    const auto cut = [&](int32_t q, int32_t origin) {
+      return static_cast<float>(tiles_.cut_m(q * (int32_t{1} << level) + origin));
+    };
+    return {cut(qx, origin_.x), cut(qx + 1, origin_.x), cut(qy, origin_.y), cut(qy + 1, origin_.y)};
+  }
+
   /// The tile's cleanup with its four cuts held; its report added to the set's.
   void clean_tile(mesh::TriangleMesh& full, int32_t qx, int32_t qy) {
-    const float x0 = static_cast<float>(tiles_.cut_m(qx + origin_.x));
-    const float x1 = static_cast<float>(tiles_.cut_m(qx + 1 + origin_.x));
-    const float y0 = static_cast<float>(tiles_.cut_m(qy + origin_.y));
-    const float y1 = static_cast<float>(tiles_.cut_m(qy + 1 + origin_.y));
+    const NodeCuts cuts = cuts_of(0, qx, qy);
     mesh::CleanupSettings cleanup = *settings_.cleanup;
-    cleanup.on_cut = [=](const Eigen::Vector3f& p) {
-      return p.x() == x0 || p.x() == x1 || p.y() == y0 || p.y() == y1;
-    };
+    cleanup.on_cut = [cuts](const Eigen::Vector3f& p) { return cuts.holds(p); };
     const mesh::CleanupReport tile = mesh::clean_mesh(full, cleanup);
     mesh::CleanupReport& sum = *report_.cleanup;
     sum.input_vertices += tile.input_vertices;
@@ -320,9 +320,9 @@ class TileSetBuilder {
   }
 
   void count(const TileSetNode& node) {
-    if (report_.levels.size() <= static_cast<std::size_t>(node.level)) {
-      report_.levels.resize(static_cast<std::size_t>(node.level) + 1);
-      report_.levels.back().level = node.level;
+    while (report_.levels.size() <= static_cast<std::size_t>(node.level)) {
+      report_.levels.emplace_back();
+      report_.levels.back().level = static_cast<int>(report_.levels.size()) - 1;
     }
     TileSetLevel& level = report_.levels[static_cast<std::size_t>(node.level)];
     level.tiles += 1;
@@ -367,7 +367,6 @@ class TileSetBuilder {
   mesh::MapTiles tiles_;
   fs::path dir_;
   TileSetSettings settings_;
-  double pad_m_;
   double voxel_m_;
   mesh::TileIndex origin_{std::numeric_limits<int32_t>::max(), std::numeric_limits<int32_t>::max()};
   std::set<std::pair<int32_t, int32_t>> leaves_;  ///< quadtree coordinates of the tiles
