@@ -33,22 +33,6 @@ void put_floats(std::string& out, const Eigen::Vector3f& v) {
   out.append(reinterpret_cast<const char*>(v.data()), 3 * sizeof(float));
 }
 
-/// Voxel key: 21 bits per axis (+-1M voxels, +-20 km at 2 cm), bit 63 set so no key is 0.
-uint64_t voxel_key(const Eigen::Vector3f& p, double voxel_size_m) {
-  uint64_t key = 0;
-  for (int k = 0; k < 3; ++k) {
-    const int64_t v = static_cast<int64_t>(std::floor(p[k] / voxel_size_m)) + (1 << 20);
-    key = (key << 21) | (static_cast<uint64_t>(v) & 0x1FFFFFu);
-  }
-  return key | (1ull << 63);
-}
-
-uint64_t slot_hash(uint64_t key) {
-  key ^= key >> 33;
-  key *= 0xFF51AFD7ED558CCDull;
-  return key ^ (key >> 33);
-}
-
 /// True when `sensor` is a preset unchanged (the rate aside, which sequence.yaml states), so
 /// that sequence.yaml may name it; a changed sensor is written out in full.
 bool is_unchanged_preset(const config::SensorModel& sensor) {
@@ -64,18 +48,22 @@ bool is_unchanged_preset(const config::SensorModel& sensor) {
   }
 }
 
-}  // namespace
-
-void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::string& path) {
-  std::ofstream out = open_for_writing(path);
-  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << points.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  std::string data;
-  data.reserve(points.size() * 12);
-  for (const Eigen::Vector3f& p : points) put_floats(data, p);
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
-  close_checked(out, path);
+std::filesystem::path created_folder(const std::string& folder) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) throw WriteError(folder + ": cannot create the folder: " + ec.message());
+  return folder;
 }
+
+mesh::TiledPointSettings truth_point_settings(double voxel_size_m) {
+  mesh::TiledPointSettings settings;
+  settings.voxel_size_m = voxel_size_m;
+  // A tile is at most 65535 voxels wide (the writer's keys).
+  settings.tile_size_m = std::min(settings.tile_size_m, 60000.0 * voxel_size_m);
+  return settings;
+}
+
+}  // namespace
 
 void write_mesh_ply(const mesh::TriangleMesh& mesh, const std::string& path) {
   std::ofstream out = open_for_writing(path);
@@ -97,12 +85,8 @@ SimulationWriter::SimulationWriter(std::string folder, config::SensorModel senso
                                    double voxel_size_m, bool write_frames)
     : folder_(std::move(folder)),
       sensor_(std::move(sensor)),
-      voxel_size_m_(voxel_size_m),
-      write_frames_(write_frames) {
-  std::error_code ec;
-  std::filesystem::create_directories(folder_, ec);
-  if (ec) throw WriteError(folder_ + ": cannot create the folder: " + ec.message());
-}
+      write_frames_(write_frames),
+      points_(created_folder(folder_) / "gt_points.ply", truth_point_settings(voxel_size_m)) {}
 
 void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d& T_map_sensor) {
   if (write_frames_) {
@@ -121,36 +105,18 @@ void SimulationWriter::add(const SimulatedFrame& frame, const Eigen::Isometry3d&
     }
   }
   trajectory_.push_back(frame.scan.stamp_ns, T_map_sensor);
-  for (const Eigen::Vector3f& p : frame.surface_points_m) {
-    if (insert_voxel(voxel_key(p, voxel_size_m_))) points_.push_back(p);
-  }
-}
-
-bool SimulationWriter::insert_voxel(uint64_t key) {
-  if (2 * (voxel_count_ + 1) > voxel_slots_.size()) {  // keep the load below one half
-    std::vector<uint64_t> old(std::max<size_t>(1 << 16, 2 * voxel_slots_.size()), 0);
-    old.swap(voxel_slots_);
-    voxel_count_ = 0;
-    for (uint64_t k : old) {
-      if (k != 0) insert_voxel(k);
-    }
-  }
-  const size_t mask = voxel_slots_.size() - 1;  // a power of two
-  for (size_t i = slot_hash(key) & mask;; i = (i + 1) & mask) {
-    if (voxel_slots_[i] == key) return false;
-    if (voxel_slots_[i] == 0) {
-      voxel_slots_[i] = key;
-      ++voxel_count_;
-      return true;
-    }
-  }
+  for (const Eigen::Vector3f& p : frame.surface_points_m) points_.add(p);
 }
 
 void SimulationWriter::finish(const mesh::TriangleMesh& mesh) {
   const std::filesystem::path dir(folder_);
   write_tum(trajectory_, (dir / "gt_trajectory.tum").string());
   write_mesh_ply(mesh, (dir / "gt_mesh.ply").string());
-  write_points_ply(points_, (dir / "gt_points.ply").string());
+  try {
+    points_.finish();
+  } catch (const mesh::MeshError& e) {
+    throw WriteError(e.what());
+  }
   if (!write_frames_) return;
   cloud::SequenceFile sequence;
   sequence.sensor = sensor_;

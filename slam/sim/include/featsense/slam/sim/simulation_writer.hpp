@@ -8,6 +8,9 @@
 ///   gt_mesh.ply         the scene's triangles, binary PLY
 ///   gt_points.ply       the noise-free surface points the sensor saw, over all frames,
 ///                       thinned to one per voxel_size_m cube (the first seen), binary PLY
+///                       grouped in 32 m tiles with their index in the header, read by
+///                       region (mesh/tiled_point_file.hpp); memory stays bounded however
+///                       long the route
 
 #include <Eigen/Geometry>
 
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "featsense/config/sensor_model.hpp"
+#include "featsense/mesh/tiled_point_file.hpp"
 #include "featsense/mesh/triangle_mesh.hpp"
 #include "featsense/slam/sim/lidar_simulator.hpp"
 #include "featsense/slam/sim/trajectory.hpp"
@@ -35,15 +39,11 @@ class SimulationWriter {
   /// and imu.csv.
   void finish(const mesh::TriangleMesh& mesh);
 
-  size_t ground_truth_points() const { return points_.size(); }
+  size_t ground_truth_points() const { return points_.points(); }
 
  private:
-  /// Inserts a voxel key; true when it was new.
-  bool insert_voxel(uint64_t key);
-
   std::string folder_;
   config::SensorModel sensor_;
-  double voxel_size_m_;
   bool write_frames_;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
@@ -51,16 +51,10 @@ class SimulationWriter {
   bool imu_written_ = false;
   int64_t last_imu_stamp_ns_ = 0;  ///< of the latest line of imu_csv_
   Trajectory trajectory_;          ///< the true pose of each frame at its stamp
-  /// Occupied voxel keys, open addressing with linear probing (0 = empty slot; keys are
-  /// never 0): a node-based set spent more time than the simulation itself.
-  std::vector<uint64_t> voxel_slots_;
-  size_t voxel_count_ = 0;
-  std::vector<Eigen::Vector3f> points_;
+  mesh::TiledPointWriter points_;  ///< gt_points.ply
 };
 
 /// Binary little-endian PLY of the mesh's vertices and triangles (metres). Throws WriteError.
 void write_mesh_ply(const mesh::TriangleMesh& mesh, const std::string& path);
-/// Binary little-endian PLY of points (metres). Throws WriteError.
-void write_points_ply(const std::vector<Eigen::Vector3f>& points, const std::string& path);
 
 }  // namespace featsense::slam
