@@ -8,14 +8,11 @@
 #include <cmath>
 
 #include "internal/closest_point_query.hpp"
+#include "internal/comparison_figures.hpp"
 #include "internal/surface_sampling.hpp"
 
 namespace featsense::mesh {
 namespace {
-
-double fraction(size_t part, size_t whole) {
-  return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
-}
 
 std::vector<float> distances_to(const internal::ClosestPointQuery& query,
                                 const std::vector<Eigen::Vector3d>& points) {
@@ -24,6 +21,10 @@ std::vector<float> distances_to(const internal::ClosestPointQuery& query,
     distances[i] = static_cast<float>(query.closest(points[i]).distance_m);
   });
   return distances;
+}
+
+double fraction(size_t part, size_t whole) {
+  return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
 }
 
 void fill_histogram(const std::vector<float>& magnitudes, double top, size_t bins,
@@ -41,6 +42,47 @@ void fill_histogram(const std::vector<float>& magnitudes, double top, size_t bin
 }
 
 }  // namespace
+
+namespace internal {
+
+void fill_accuracy_figures(const CompareSettings& settings, CompareResult* result) {
+  result->points = result->unsigned_distance_m.size();
+  result->beyond_max_dist = 0;
+  std::vector<float> kept;
+  std::vector<float> kept_magnitudes;
+  for (size_t i = 0; i < result->points; ++i) {
+    if (settings.max_dist_m > 0.0 && result->unsigned_distance_m[i] > settings.max_dist_m) {
+      ++result->beyond_max_dist;
+      continue;
+    }
+    kept.push_back(result->signed_distance_m[i]);
+    kept_magnitudes.push_back(result->unsigned_distance_m[i]);
+  }
+  result->accuracy = distance_statistics(kept);
+  fill_histogram(kept_magnitudes,
+                 settings.max_dist_m > 0.0 ? settings.max_dist_m : result->accuracy.max,
+                 settings.histogram_bins, result);
+}
+
+void fill_scores(const CompareSettings& settings, const std::vector<size_t>& samples_within,
+                 CompareResult* result) {
+  result->scores.clear();
+  for (size_t k = 0; k < settings.thresholds_m.size(); ++k) {
+    const double t = settings.thresholds_m[k];
+    ThresholdScores s;
+    s.threshold_m = t;
+    s.precision = fraction(static_cast<size_t>(std::count_if(result->unsigned_distance_m.begin(),
+                                                             result->unsigned_distance_m.end(),
+                                                             [t](float d) { return d <= t; })),
+                           result->points);
+    s.completeness = fraction(samples_within[k], result->reference_samples);
+    const double sum = s.precision + s.completeness;
+    s.fscore = sum > 0.0 ? 2.0 * s.precision * s.completeness / sum : 0.0;
+    result->scores.push_back(s);
+  }
+}
+
+}  // namespace internal
 
 DistanceStatistics distance_statistics(const std::vector<float>& signed_distance_m) {
   DistanceStatistics s;
@@ -93,7 +135,6 @@ CompareResult compare_to_reference(const TriangleMesh& estimate, const TriangleM
 
   // Accuracy: every estimate vertex to the reference.
   const size_t n = estimate.vertices.size();
-  result.points = n;
   result.unsigned_distance_m.resize(n);
   result.signed_distance_m.resize(n);
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
@@ -105,20 +146,7 @@ CompareResult compare_to_reference(const TriangleMesh& estimate, const TriangleM
     result.signed_distance_m[i] =
         static_cast<float>(result.signed_distances ? sign * c.distance_m : c.distance_m);
   });
-  std::vector<float> kept;
-  std::vector<float> kept_magnitudes;
-  for (size_t i = 0; i < n; ++i) {
-    if (settings.max_dist_m > 0.0 && result.unsigned_distance_m[i] > settings.max_dist_m) {
-      ++result.beyond_max_dist;
-      continue;
-    }
-    kept.push_back(result.signed_distance_m[i]);
-    kept_magnitudes.push_back(result.unsigned_distance_m[i]);
-  }
-  result.accuracy = distance_statistics(kept);
-  fill_histogram(kept_magnitudes,
-                 settings.max_dist_m > 0.0 ? settings.max_dist_m : result.accuracy.max,
-                 settings.histogram_bins, &result);
+  internal::fill_accuracy_figures(settings, &result);
 
   // Completeness: reference samples (or points) to the estimate.
   std::vector<Eigen::Vector3d> samples;
@@ -140,20 +168,12 @@ CompareResult compare_to_reference(const TriangleMesh& estimate, const TriangleM
   const internal::ClosestPointQuery to_estimate(estimate);
   const std::vector<float> back = distances_to(to_estimate, samples);
 
+  std::vector<size_t> within;
   for (double t : settings.thresholds_m) {
-    ThresholdScores s;
-    s.threshold_m = t;
-    s.precision = fraction(static_cast<size_t>(std::count_if(result.unsigned_distance_m.begin(),
-                                                             result.unsigned_distance_m.end(),
-                                                             [t](float d) { return d <= t; })),
-                           n);
-    s.completeness = fraction(static_cast<size_t>(std::count_if(back.begin(), back.end(),
-                                                                [t](float d) { return d <= t; })),
-                              back.size());
-    const double sum = s.precision + s.completeness;
-    s.fscore = sum > 0.0 ? 2.0 * s.precision * s.completeness / sum : 0.0;
-    result.scores.push_back(s);
+    within.push_back(static_cast<size_t>(
+        std::count_if(back.begin(), back.end(), [t](float d) { return d <= t; })));
   }
+  internal::fill_scores(settings, within, &result);
   return result;
 }
 
