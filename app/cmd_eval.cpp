@@ -10,8 +10,11 @@
 #include "commands.hpp"
 #include "eval_json.hpp"
 #include "featsense/config/config_error.hpp"
+#include "featsense/mesh/region_comparison.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/ply_mesh_io.hpp"
+#include "featsense/viewer_export/surface_file_regions.hpp"
 #include "json_output.hpp"
 #include "mesh_error_files.hpp"
 
@@ -104,28 +107,38 @@ void run_traj(const EvalTrajOptions& options) {
   emit(json, options.json_path, text);
 }
 
-mesh::TriangleMesh read_mesh(const std::string& path, const std::string& what) {
+/// MESH or REFERENCE by what it is: a tile set's folder, a tiled point file, a mesh file.
+std::unique_ptr<mesh::SurfaceRegions> open_surface(const std::string& path,
+                                                   const std::string& what) {
   try {
-    return viewer_export::read_ply_mesh(path);
-  } catch (const viewer_export::PlyError& e) {
+    return viewer_export::open_surface_regions(path);
+  } catch (const std::exception& e) {
     throw std::runtime_error(what + ": " + e.what());
   }
 }
 
 void run_mesh(const EvalMeshOptions& options) {
-  const mesh::TriangleMesh estimate = read_mesh(options.estimate, "MESH");
-  const mesh::TriangleMesh reference = read_mesh(options.reference, "REFERENCE");
+  if (options.ply_path && viewer_export::is_tile_set(options.estimate)) {
+    throw std::runtime_error("--ply-out colours one mesh; " + options.estimate +
+                             " is a tile set (compare a tile's PLY for the picture)");
+  }
+  // Read a region at a time (mesh/region_comparison.hpp): a tile set or a simulator's dense
+  // truth is never whole in memory; the figures are those of the whole comparison.
+  const std::unique_ptr<mesh::SurfaceRegions> estimate = open_surface(options.estimate, "MESH");
+  const std::unique_ptr<mesh::SurfaceRegions> reference =
+      open_surface(options.reference, "REFERENCE");
   mesh::CompareSettings settings;
   settings.max_dist_m = options.max_dist_m;
   settings.samples_per_m2 = options.samples_per_m2;
   mesh::CompareResult result;
   try {
-    result = mesh::compare_to_reference(estimate, reference, settings);
+    result = mesh::compare_by_region(*estimate, *reference, settings);
   } catch (const mesh::MeshError& e) {
     throw std::runtime_error(options.estimate + " vs " + options.reference + ": " + e.what());
   }
   if (options.ply_path) {
-    viewer_export::write_ply_mesh(*options.ply_path, estimate, distance_layers(result));
+    viewer_export::write_ply_mesh(*options.ply_path, viewer_export::read_mesh(options.estimate),
+                                  distance_layers(result));
   }
   nlohmann::json json = mesh_comparison_json(result, settings);
   json["estimate"] = options.estimate;
@@ -188,9 +201,14 @@ std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/)
   auto mesh_options = std::make_shared<EvalMeshOptions>();
   CLI::App* mesh_command = eval->add_subcommand(
       "mesh", "Mesh vs reference mesh or cloud: cloud-to-mesh accuracy, completeness, F-score");
-  mesh_command->add_option("MESH", mesh_options->estimate, "Estimated mesh (PLY)")->required();
   mesh_command
-      ->add_option("REFERENCE", mesh_options->reference, "Reference mesh or point cloud (PLY)")
+      ->add_option("MESH", mesh_options->estimate,
+                   "Estimated mesh (PLY, OBJ, glTF) or a tile set's folder (mesh --tiles)")
+      ->required();
+  mesh_command
+      ->add_option("REFERENCE", mesh_options->reference,
+                   "Reference mesh or point cloud (PLY, OBJ, glTF; a simulator's gt_points.ply "
+                   "is read a tile at a time)")
       ->required();
   mesh_command
       ->add_option("--max-dist", mesh_options->max_dist_m,

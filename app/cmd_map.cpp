@@ -319,10 +319,14 @@ MapOutcome map_recording(slam::ScanSource& source, std::optional<slam::Trajector
     const MeshErrorOutputs error_outputs{
         out, plan_inputs(options, result.final_poses, !result.odometry, truth)};
     if (options.tiles) {
-      // The overview is a coarser level: comparing it with the truth would measure the
-      // simplification, not the map.
+      // The full-resolution tiles are compared with the truth, not the overview (a coarser
+      // level: that would measure the simplification, not the map).
       report["mesh"] =
           mesh_json(mesh_map_tiles(out / "map.h5", out, error_outputs.plan, context.quiet));
+      if (std::optional<nlohmann::json> evaluation =
+              evaluate_tile_set(out / "tiles", references, T_truth_estimate)) {
+        report["eval"]["mesh"] = *evaluation;
+      }
     } else {
       const MapMesh meshed = mesh_map(out / "map.h5", out, error_outputs.plan);
       report["mesh"] = mesh_json(meshed);
@@ -369,7 +373,7 @@ void add_map_output_flags(CLI::App& command, MapOptions& options) {
                    "Write the map only, no mesh.ply / mesh.glb / topdown.png");
   command.add_flag("--tiles", options.tiles,
                    "The mesh as a tile set (OUT/tiles/: a mesh per tile, 3D Tiles), memory "
-                   "bounded by a tile, for large maps; not compared with a reference");
+                   "bounded by a tile, for large maps");
   command.add_flag("--no-loop-closure", options.no_loop_closure,
                    "Map with the odometry's poses alone (loop.enabled false)");
 }

@@ -2,12 +2,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "eval_json.hpp"
 #include "featsense/mesh/compare_to_reference.hpp"
+#include "featsense/mesh/region_comparison.hpp"
+#include "featsense/mesh/surface_regions.hpp"
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/plan_view.hpp"
+#include "featsense/viewer_export/surface_file_regions.hpp"
 #include "mesh_error_files.hpp"
 #include "mesh_tile_set.hpp"
 
@@ -141,49 +145,88 @@ MeshReferences find_mesh_references(const std::string& input,
   return references;
 }
 
+namespace {
+
+/// The evaluation of `estimate` (see evaluate_map_mesh), a region at a time; the distances
+/// to the surface in `against_surface` where given.
+nlohmann::json evaluate_by_region(const mesh::SurfaceRegions& estimate,
+                                  const MeshReferences& references,
+                                  const std::optional<Eigen::Isometry3d>& T_truth_estimate,
+                                  mesh::CompareResult* against_surface_out) {
+  const mesh::CompareSettings settings;
+  const bool seen = references.seen && fs::is_regular_file(*references.seen);
+  const std::unique_ptr<mesh::SurfaceRegions> surface =
+      viewer_export::open_surface_regions(*references.surface);
+  mesh::RegionComparisonSettings regions;
+  regions.completeness = !seen;  // else measured against what the sensor saw, below
+  mesh::CompareResult against_surface =
+      mesh::compare_by_region(estimate, *surface, settings, regions);
+  nlohmann::json json = mesh_comparison_json(against_surface, settings);
+  json["reference_file"] = references.surface->string();
+  if (T_truth_estimate) {
+    // The reference moved into the map's frame: the same distances as the mesh moved onto
+    // the truth, for a fraction of the vertices.
+    const mesh::MovedRegions moved(*surface, T_truth_estimate->inverse());
+    regions.completeness = false;
+    const mesh::CompareResult aligned = mesh::compare_by_region(estimate, moved, settings, regions);
+    json["aligned"] = {{"by", "the estimated trajectory's SE(3) alignment to the true one"},
+                       {"accuracy", mesh_comparison_json(aligned, settings)["accuracy"]}};
+  }
+  if (seen) {
+    // Completeness counts only what the sensor saw: the points behind its returns (the
+    // simulator's, in tiles: read a tile at a time).
+    const std::unique_ptr<mesh::SurfaceRegions> seen_points =
+        viewer_export::open_surface_regions(*references.seen);
+    regions.accuracy = false;
+    regions.completeness = true;
+    const mesh::CompareResult against_seen =
+        mesh::compare_by_region(estimate, *seen_points, settings, regions);
+    json["completeness"] = mesh_comparison_json(against_seen, settings)["completeness"];
+    for (auto& [key, precision] : json["precision"].items()) {
+      const double p = precision.get<double>();
+      const double c = json["completeness"][key].get<double>();
+      json["fscore"][key] = p + c > 0.0 ? 2.0 * p * c / (p + c) : 0.0;
+    }
+    json["completeness_reference"] = references.seen->string();
+    json["completeness_samples"] = against_seen.reference_samples;
+    json["reference_samples"] = against_seen.reference_samples;
+    json["samples_per_m2"] = against_seen.samples_per_m2;
+  }
+  if (against_surface_out) *against_surface_out = std::move(against_surface);
+  return json;
+}
+
+bool has_surface_reference(const MeshReferences& references) {
+  // A reference may be missing: a simulation that was interrupted wrote no ground truth.
+  return references.surface && fs::exists(*references.surface);
+}
+
+}  // namespace
+
 std::optional<nlohmann::json> evaluate_map_mesh(
     const mesh::TriangleMesh& mesh, const MeshReferences& references,
     const std::optional<Eigen::Isometry3d>& T_truth_estimate,
     const MeshErrorOutputs* error_outputs) {
-  // A reference may be missing: a simulation that was interrupted wrote no ground truth.
-  if (!references.surface || !fs::is_regular_file(*references.surface) || mesh.triangles.empty()) {
-    return std::nullopt;
-  }
-  const mesh::CompareSettings settings;
-  const mesh::TriangleMesh surface = viewer_export::read_mesh(references.surface->string());
-  const mesh::CompareResult against_surface = mesh::compare_to_reference(mesh, surface, settings);
-  nlohmann::json json = mesh_comparison_json(against_surface, settings);
-  json["reference_file"] = references.surface->string();
+  if (!has_surface_reference(references) || mesh.triangles.empty()) return std::nullopt;
+  mesh::CompareResult against_surface;
+  nlohmann::json json =
+      evaluate_by_region(mesh::MeshRegions(mesh), references, T_truth_estimate, &against_surface);
   if (error_outputs) {
     json["error_files"] =
         write_mesh_error_files(error_outputs->dir, mesh, against_surface, error_outputs->plan.paths,
                                error_outputs->plan.settings);
   }
-  if (T_truth_estimate) {
-    // The reference moved into the map's frame: the same distances as the mesh moved onto
-    // the truth, for a fraction of the vertices.
-    mesh::TriangleMesh moved = surface;
-    const Eigen::Isometry3f T_estimate_truth = T_truth_estimate->inverse().cast<float>();
-    for (Eigen::Vector3f& v : moved.vertices) v = T_estimate_truth * v;
-    for (Eigen::Vector3f& n : moved.normals) n = T_estimate_truth.linear() * n;
-    const mesh::CompareResult aligned = mesh::compare_to_reference(mesh, moved, settings);
-    json["aligned"] = {{"by", "the estimated trajectory's SE(3) alignment to the true one"},
-                       {"accuracy", mesh_comparison_json(aligned, settings)["accuracy"]}};
-  }
-  if (!references.seen || !fs::is_regular_file(*references.seen)) return json;
-
-  // Completeness counts only what the sensor saw: the points behind its returns.
-  const mesh::TriangleMesh seen = viewer_export::read_mesh(references.seen->string());
-  const mesh::CompareResult against_seen = mesh::compare_to_reference(mesh, seen, settings);
-  json["completeness"] = mesh_comparison_json(against_seen, settings)["completeness"];
-  for (auto& [key, precision] : json["precision"].items()) {
-    const double p = precision.get<double>();
-    const double c = json["completeness"][key].get<double>();
-    json["fscore"][key] = p + c > 0.0 ? 2.0 * p * c / (p + c) : 0.0;
-  }
-  json["completeness_reference"] = references.seen->string();
-  json["completeness_samples"] = against_seen.reference_samples;
   return json;
+}
+
+std::optional<nlohmann::json> evaluate_tile_set(
+    const fs::path& tile_set_dir, const MeshReferences& references,
+    const std::optional<Eigen::Isometry3d>& T_truth_estimate) {
+  if (!has_surface_reference(references)) return std::nullopt;
+  const std::unique_ptr<mesh::SurfaceRegions> tiles =
+      viewer_export::open_tile_set_regions(tile_set_dir);
+  if (tiles->bounds().isEmpty()) return std::nullopt;
+  return evaluate_by_region(*tiles, references, T_truth_estimate, nullptr);
 }
 
 }  // namespace featsense::app

@@ -89,9 +89,18 @@ MeshReferences find_mesh_references(const std::string& input,
 /// its first metres puts a wall 200 m away 17 cm too high however consistent the map is.
 /// With `error_outputs`, the distances to `surface` (in the map's frame, as the plain score)
 /// are written as mesh_error.ply, .glb and .png (mesh_error_files.hpp), named in `error_files`.
+/// The comparison runs a region at a time (mesh/region_comparison.hpp): the truth is read
+/// around one region, then the next (the simulator's gt_points.ply a tile at a time), so that
+/// the memory is the mesh's and a region's, not the truth's.
 std::optional<nlohmann::json> evaluate_map_mesh(
     const mesh::TriangleMesh& mesh, const MeshReferences& references,
     const std::optional<Eigen::Isometry3d>& T_truth_estimate = std::nullopt,
     const MeshErrorOutputs* error_outputs = nullptr);
+
+/// The same for a tile set on disk (`map --tiles`; tile_set.hpp), read a few tiles at a time:
+/// the memory of a region, whatever the map's size. No error files (they colour one mesh).
+std::optional<nlohmann::json> evaluate_tile_set(
+    const std::filesystem::path& tile_set_dir, const MeshReferences& references,
+    const std::optional<Eigen::Isometry3d>& T_truth_estimate = std::nullopt);
 
 }  // namespace featsense::app

@@ -163,6 +163,31 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
   EXPECT_EQ(result.output, "");
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "q" / "tiles" / "0" / "0_0.glb"));
   EXPECT_FALSE(std::filesystem::exists(dir / "q" / "tiles" / "0" / "0_0.ply"));
+
+  // A tile set is compared with a reference as the one mesh is (its tiles read a few at a
+  // time, their shared vertices once), from PLY or GLB tiles. The reference: one quarter.
+  const std::string reference = (dir / "t" / "tiles" / "0" / "-1_-1.ply").string();
+  auto eval = [&](const std::string& estimate) {
+    const CommandResult run =
+        run_featsense("eval mesh " + estimate + " " + reference + " --json -");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return nlohmann::json::parse(run.output.substr(run.output.find('{')));
+  };
+  const nlohmann::json one = eval((dir / "one.ply").string());
+  EXPECT_GT(one["accuracy"]["max"].get<double>(), 0.5) << "the other quarters are far off";
+  for (const char* set : {"t", "q"}) {
+    const nlohmann::json tiled = eval((dir / set).string());
+    EXPECT_EQ(tiled["points"], one["points"]) << set;
+    EXPECT_NEAR(tiled["accuracy"]["mean_abs"].get<double>(),
+                one["accuracy"]["mean_abs"].get<double>(), 1e-9)
+        << set;
+    EXPECT_EQ(tiled["accuracy"]["max"], one["accuracy"]["max"]) << set;
+    EXPECT_EQ(tiled["completeness"], one["completeness"]) << set;
+  }
+  result = run_featsense("eval mesh " + (dir / "t").string() + " " + reference + " --ply-out " +
+                         (dir / "e.ply").string());
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("is a tile set"), std::string::npos) << result.output;
 }
 
 TEST(CliMesh, ErrorsAreClear) {

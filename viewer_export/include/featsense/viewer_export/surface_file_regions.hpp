@@ -1,0 +1,27 @@
+#pragma once
+/// Surfaces on disk read by region (mesh/surface_regions.hpp), for comparisons that must not
+/// hold a city: a tile set's folder (tile_set.hpp) a few tiles at a time, a tiled point file
+/// (the simulator's gt_points.ply) a tile at a time, any other mesh or cloud file whole.
+
+#include <filesystem>
+#include <memory>
+
+#include "featsense/mesh/surface_regions.hpp"
+
+namespace featsense::viewer_export {
+
+/// A tile set's full-resolution tiles (tiles.json; PLY where written, else GLB), the last
+/// `cached_tiles` kept in memory; the copies of a vertex on a cut between tiles come once
+/// (GLB tiles are re-centred: copies within 10 micrometres are one).
+/// Throws MeshFileError naming the folder when its index cannot be read.
+std::unique_ptr<mesh::SurfaceRegions> open_tile_set_regions(const std::filesystem::path& dir,
+                                                            std::size_t cached_tiles = 16);
+
+/// A tile set's folder, a tiled point file or a mesh file (read_mesh), by what `path` is.
+/// Throws MeshFileError (PlyError, mesh::MeshError) naming the path.
+std::unique_ptr<mesh::SurfaceRegions> open_surface_regions(const std::filesystem::path& path);
+
+/// True when `dir` holds a tile set's index (tiles.json).
+bool is_tile_set(const std::filesystem::path& dir);
+
+}  // namespace featsense::viewer_export
