@@ -140,7 +140,9 @@ Command register_demo(CLI::App& app, const CliContext& context) {
   CLI::App* command = app.add_subcommand(
       "demo", "Simulate a built-in scene, map it, mesh it and compare it with the truth");
   command->add_option("-o,--output", options->output, "Output folder")->capture_default_str();
-  command->add_option("--scene", options->scene, "Built-in scene: lab, parking, corridor or town")
+  command
+      ->add_option("--scene", options->scene,
+                   "Built-in scene: lab, parking, corridor, town, town-changed or city")
       ->check(CLI::IsMember(slam::scene_names()))
       ->capture_default_str();
   // Which paths a scene has is the scene library's to say (an unknown one is an error that
@@ -148,7 +150,7 @@ Command register_demo(CLI::App& app, const CliContext& context) {
   command
       ->add_option("--path", options->path,
                    "The sensor's path: walk, drive, drone (lab, corridor, parking), loop "
-                   "(parking, town)")
+                   "(parking, town), tour (city)")
       ->capture_default_str();
   command->add_option("--frames", options->frames, "Frames to simulate (default: the whole path)")
       ->check(CLI::Range(1, 100000));

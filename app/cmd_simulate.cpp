@@ -148,7 +148,8 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
       "simulate", "Simulate a spinning LiDAR in a built-in scene or a mesh, with ground truth");
   command
       ->add_option("--scene", o->scene,
-                   "Built-in scene (lab, parking, corridor, town) or a mesh file (PLY, OBJ, "
+                   "Built-in scene (lab, parking, corridor, town, town-changed, city) or a mesh "
+                   "file (PLY, OBJ, "
                    "glTF/GLB, DAE, STL)")
       ->required();
   command->add_option("-o,--output", o->output_dir, "Folder for the recording")->required();

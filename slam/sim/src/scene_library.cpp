@@ -165,7 +165,7 @@ std::vector<Eigen::Vector3d> parking_loop() {
 }  // namespace
 
 std::vector<std::string> scene_names() {
-  return {"corridor", "lab", "parking", "town", "town-changed"};
+  return {"city", "corridor", "lab", "parking", "town", "town-changed"};
 }
 
 bool is_builtin_scene(const std::string& name) {
@@ -181,12 +181,14 @@ mesh::TriangleMesh build_scene(const std::string& name) {
   if (name == "corridor") return corridor();
   if (name == "town") return town::build_town();
   if (name == "town-changed") return town::build_town(town::ParkedCars::kAnotherDay);
+  if (name == "city") return town::build_town(town::ParkedCars::kMappingDay, town::kCityLayout);
   throw std::invalid_argument(unknown_scene(name));
 }
 
 std::vector<std::string> path_names(const std::string& scene) {
   if (!is_builtin_scene(scene)) throw std::invalid_argument(unknown_scene(scene));
   if (scene == "town" || scene == "town-changed") return town::town_path_names();
+  if (scene == "city") return town::city_path_names();
   if (scene == "parking") return {"walk", "drive", "drone", "loop"};
   return {"walk", "drive", "drone"};
 }
@@ -199,6 +201,8 @@ NamedPath scene_path(const std::string& scene, const std::string& path) {
   out.name = path;
   if (scene == "town" || scene == "town-changed") {
     out = town::town_path(path);
+  } else if (scene == "city") {
+    out = town::city_path(path);
   } else if (scene == "lab") {
     if (path == "walk") {
       out.waypoints_m = at_height({P(-7.5, -7.5), P(0, -7.5), P(7.5, -7), P(7.5, 0), P(7, 7.5),

@@ -29,9 +29,9 @@ struct BlockGround {
 };
 
 /// What a block is built from: blocks of one design are alike, wherever they stand.
-uint32_t block_design(int i, int j) {
-  if (j == kTwinJ && i == kTwinI[1]) return block_design(kTwinI[0], j);
-  return static_cast<uint32_t>(1 + i + kBlockColumns * j);
+uint32_t block_design(int i, int j, int columns) {
+  if (j == kTwinJ && i == kTwinI[1]) return block_design(kTwinI[0], j, columns);
+  return static_cast<uint32_t>(1 + i + columns * j);
 }
 
 float wall_reflectance(uint32_t design, uint32_t building) {
@@ -176,13 +176,14 @@ void for_each_planar_piece(float x0, float x1, Fn fn) {
 
 /// The rows of buildings beyond the outer streets, their facades facing the town, on a
 /// sidewalk that runs under them. `row` 0..3: south, east, north, west.
-void add_outer_row(mesh::TriangleMesh& m, uint32_t row, float lo_m, float hi_m) {
+void add_outer_row(mesh::TriangleMesh& m, uint32_t row, float lo_m, float hi_m,
+                   const TownLayout& layout) {
   constexpr float kDepthM = 9.5f;
   const uint32_t kerb = m.add_part("sidewalk", Materials::kConcrete);
   const float near = kHalfRoadM;  // kerb, from the outer street's centre line
   const float front = kHalfRoadM + kSidewalkM;
-  const float town_x = kBlockColumns * kPitchM;
-  const float town_y = kBlockRows * kPitchM;
+  const float town_x = static_cast<float>(layout.columns) * kPitchM;
+  const float town_y = static_cast<float>(layout.rows) * kPitchM;
   // The strip across the row: [a0, a1] away from the town's edge street.
   const auto footprint = [&](float s0, float s1, float a0, float a1, float* x0, float* y0,
                              float* x1, float* y1) {
@@ -223,10 +224,10 @@ void add_outer_row(mesh::TriangleMesh& m, uint32_t row, float lo_m, float hi_m) 
 
 }  // namespace
 
-mesh::TriangleMesh build_town(ParkedCars cars) {
+mesh::TriangleMesh build_town(ParkedCars cars, TownLayout layout) {
   mesh::TriangleMesh m;
-  const float town_x = kBlockColumns * kPitchM;
-  const float town_y = kBlockRows * kPitchM;
+  const float town_x = static_cast<float>(layout.columns) * kPitchM;
+  const float town_y = static_cast<float>(layout.rows) * kPitchM;
   const float edge = kHalfRoadM + kSidewalkM + 11.0f;  // beyond the outer rows
   const uint32_t asphalt = m.add_part("asphalt", Materials::kAsphalt);
   for_each_planar_piece(-edge, town_x + edge, [&](float a, float b) {
@@ -236,15 +237,16 @@ mesh::TriangleMesh build_town(ParkedCars cars) {
                asphalt);
   });
   // South and north rows run past the corners; east and west rows fit between them.
-  add_outer_row(m, 0, -edge, town_x + edge);
-  add_outer_row(m, 2, -edge, town_x + edge);
-  add_outer_row(m, 1, -kHalfRoadM, town_y + kHalfRoadM);
-  add_outer_row(m, 3, -kHalfRoadM, town_y + kHalfRoadM);
-  for (int j = 0; j < kBlockRows; ++j) {
-    for (int i = 0; i < kBlockColumns; ++i) {
+  add_outer_row(m, 0, -edge, town_x + edge, layout);
+  add_outer_row(m, 2, -edge, town_x + edge, layout);
+  add_outer_row(m, 1, -kHalfRoadM, town_y + kHalfRoadM, layout);
+  add_outer_row(m, 3, -kHalfRoadM, town_y + kHalfRoadM, layout);
+  for (int j = 0; j < layout.rows; ++j) {
+    for (int i = 0; i < layout.columns; ++i) {
       const float x = kPitchM * static_cast<float>(i);
       const float y = kPitchM * static_cast<float>(j);
-      append_placed(m, block(block_design(i, j), BlockGround{x}, cars), 0, V(x, y, 0));
+      append_placed(m, block(block_design(i, j, layout.columns), BlockGround{x}, cars), 0,
+                    V(x, y, 0));
     }
   }
   return m;

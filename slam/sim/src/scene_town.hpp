@@ -43,11 +43,23 @@ constexpr int kTwinJ = 1;
 /// drawn anew (taken or empty), a car in it another model, parked up to 0.5 m further along.
 enum class ParkedCars { kMappingDay, kAnotherDay };
 
+/// The grid of blocks: the town's 4 x 3, or a larger one (the `city`: the town's streets and
+/// rise, more blocks east and north, each of its own design but the twins).
+struct TownLayout {
+  int columns = kBlockColumns;
+  int rows = kBlockRows;
+};
+inline constexpr TownLayout kCityLayout{12, 8};
+
 /// The mesh (map frame, metres, Z up; roads at z = 0 west of the rise).
-mesh::TriangleMesh build_town(ParkedCars cars = ParkedCars::kMappingDay);
+mesh::TriangleMesh build_town(ParkedCars cars = ParkedCars::kMappingDay, TownLayout layout = {});
 /// "loop", "drive", "walk".
 std::vector<std::string> town_path_names();
 /// The named path, or one without waypoints when `name` is none of town_path_names().
 NamedPath town_path(const std::string& name);
+/// "tour": about 5 km through the city.
+std::vector<std::string> city_path_names();
+/// The named path, or one without waypoints when `name` is none of city_path_names().
+NamedPath city_path(const std::string& name);
 
 }  // namespace featsense::slam::town

@@ -73,4 +73,25 @@ NamedPath town_path(const std::string& name) {
   return out;
 }
 
+std::vector<std::string> city_path_names() { return {"tour"}; }
+
+NamedPath city_path(const std::string& name) {
+  NamedPath out;
+  out.name = name;
+  if (name == "tour") {
+    // About 5 km through the 12 x 8 blocks of the city, new streets most of the way: west to
+    // east and back along every second street y = 0, 100, ..., 400 (3.4 km), then revisits:
+    // round a block and back along y = 400 (opposite direction), south across every one of
+    // those streets on x = 300, north on x = 200 and south on x = 50 (crossing each twice
+    // more). A prefix of it (--frames) is a shorter route through the same city.
+    const std::vector<P> grid = {P(0, 0),  P(12, 0), P(12, 2), P(0, 2), P(0, 4),
+                                 P(12, 4), P(12, 6), P(0, 6),  P(0, 8), P(12, 8),
+                                 P(12, 7), P(11, 7), P(11, 8), P(6, 8), P(6, 0),
+                                 P(4, 0),  P(4, 8),  P(1, 8),  P(1, 1)};
+    out.waypoints_m = above_road(street_route(crossings(grid), car_lane()), kCarSensorHeightM);
+    out.speed_mps = 7.0;
+  }
+  return out;
+}
+
 }  // namespace featsense::slam::town

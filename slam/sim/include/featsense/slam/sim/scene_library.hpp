@@ -11,14 +11,16 @@
 
 namespace featsense::slam {
 
-/// Names of the built-in scenes: "corridor", "lab", "parking", "town". The town: a 4 x 3
+/// Names of the built-in scenes: "city", "corridor", "lab", "parking", "town". The town: a 4 x 3
 /// grid of blocks (x in [0, 200], y in [0, 150] between the outer streets' centre lines, on
 /// a 50 m grid, 12 m carriageways) closed by outer rows of buildings; the ground rises 3 m
 /// between x = 156 and 194; blocks (0, 1) and (2, 1), with their lower-left street crossings
 /// at (0, 50) and (100, 50), are alike (the same mesh moved 100 m along x). "town-changed":
 /// the town on another day, its paths the town's: the cars parked along its kerbs moved
 /// (each bay drawn anew, taken or empty; another model, up to 0.5 m further along), the rest
-/// the same, for localizing in a map made of "town".
+/// the same, for localizing in a map made of "town". "city": the town's streets, rise and
+/// twin blocks in a 12 x 8 grid of blocks (x in [0, 600], y in [0, 400]), for routes of
+/// kilometres (its path "tour": about 5 km).
 std::vector<std::string> scene_names();
 /// True when `name` is a built-in scene.
 bool is_builtin_scene(const std::string& name);
@@ -35,8 +37,8 @@ struct NamedPath {
 };
 
 /// Names of the paths of a built-in scene: "walk", "drive", "drone" (lab, corridor), and
-/// "loop" (parking); "loop", "drive", "walk" (town, town-changed). Throws std::invalid_argument
-/// naming the scenes when `scene` is unknown.
+/// "loop" (parking); "loop", "drive", "walk" (town, town-changed); "tour" (city). Throws
+/// std::invalid_argument naming the scenes when `scene` is unknown.
 std::vector<std::string> path_names(const std::string& scene);
 /// A named path through a built-in scene; throws std::invalid_argument when either name is
 /// unknown (naming the scenes, or that scene's paths).
