@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <fstream>
 #include <map>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "featsense/storage/hdf5_chunk_store.hpp"
 #include "featsense/storage/vdb_io.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
+#include "featsense/viewer_export/ply_mesh_io.hpp"
 #include "mesh/tsdf_test_fields.hpp"
 
 namespace featsense::test {
@@ -188,6 +190,50 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
                          (dir / "e.ply").string());
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("is a tile set"), std::string::npos) << result.output;
+
+  // Navigation layers a tile at a time (with its neighbours) are the whole mesh's, vertex for
+  // vertex, on the cuts too. A steep limit so that the sphere has lethal and free parts.
+  const std::string limits = " --max-slope-deg 40 --radius 0.2";
+  result = run_featsense("navmesh " + (dir / "one.ply").string() + " -o " +
+                         (dir / "nav_one.ply").string() + limits);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  result =
+      run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav").string() + limits);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("4 tiles"), std::string::npos) << result.output;
+  using Key = std::array<float, 3>;
+  auto layers_by_position = [](const std::filesystem::path& file) {
+    viewer_export::MeshAttributes attributes;
+    const mesh::TriangleMesh m = viewer_export::read_ply_mesh(file.string(), &attributes);
+    std::map<Key, std::vector<float>> out;
+    for (size_t v = 0; v < m.vertices.size(); ++v) {
+      std::vector<float>& values = out[{m.vertices[v].x(), m.vertices[v].y(), m.vertices[v].z()}];
+      for (const viewer_export::VertexScalar& layer : attributes.scalars)
+        values.push_back(layer.values[v]);
+    }
+    return out;
+  };
+  const std::map<Key, std::vector<float>> whole = layers_by_position(dir / "nav_one.ply");
+  size_t compared = 0;
+  size_t lethal = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "nav")) {
+    if (entry.path().extension() != ".ply") continue;
+    for (const auto& [position, values] : layers_by_position(entry.path())) {
+      const auto found = whole.find(position);
+      ASSERT_NE(found, whole.end()) << "a tile's vertex is not in the whole mesh";
+      ASSERT_EQ(values.size(), found->second.size());
+      for (size_t k = 0; k < values.size(); ++k) EXPECT_NEAR(values[k], found->second[k], 1e-4);
+      lethal += values.back() > 0.5f ? 1 : 0;
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, whole.size());  // the cuts' vertices in two tiles
+  EXPECT_GT(lethal, 0u);
+  EXPECT_LT(lethal, compared);
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "nav" / "navmesh.json"));
+  result = run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav.ply").string());
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("-o names a folder"), std::string::npos) << result.output;
 }
 
 TEST(CliMesh, ErrorsAreClear) {

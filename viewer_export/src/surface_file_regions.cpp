@@ -91,29 +91,11 @@ class TileSetRegions final : public mesh::SurfaceRegions {
  public:
   TileSetRegions(const fs::path& dir, std::size_t cached_tiles)
       : dir_(dir), cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {
-    const fs::path index_path = dir / "tiles.json";
-    std::ifstream in(index_path);
-    if (!in) throw MeshFileError(index_path.string() + ": cannot be read");
-    try {
-      const nlohmann::json index = nlohmann::json::parse(in);
-      bounds_.setEmpty();
-      for (const nlohmann::json& tile : index.at("tiles")) {
-        const std::vector<double> b = tile.at("bounds_m").get<std::vector<double>>();
-        if (b.size() != 6) throw MeshFileError("a tile's bounds_m is not six numbers");
-        Tile t;
-        t.bounds = Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]),
-                                       Eigen::Vector3d(b[3], b[4], b[5]));
-        const nlohmann::json& file = tile.contains("ply") ? tile.at("ply") : tile.at("glb");
-        if (!file.is_string()) throw MeshFileError("a tile's file is not a string");
-        t.file = file.get<std::string>();
-        glb_ = glb_ || mesh_extension(t.file) != ".ply";
-        bounds_.extend(t.bounds);
-        tiles_.push_back(std::move(t));
-      }
-    } catch (const nlohmann::json::exception& e) {
-      throw MeshFileError(index_path.string() + ": not a tile set's index: " + e.what());
-    } catch (const MeshFileError& e) {
-      throw MeshFileError(index_path.string() + ": " + e.what());
+    bounds_.setEmpty();
+    for (TileSetEntry& entry : read_tile_set_index(dir)) {
+      bounds_.extend(entry.bounds);
+      glb_ = glb_ || mesh_extension(entry.file) != ".ply";
+      tiles_.push_back({entry.bounds, std::move(entry.file)});
     }
   }
 
@@ -172,6 +154,34 @@ class TileSetRegions final : public mesh::SurfaceRegions {
 };
 
 }  // namespace
+
+std::vector<TileSetEntry> read_tile_set_index(const fs::path& dir) {
+  const fs::path index_path = dir / "tiles.json";
+  std::ifstream in(index_path);
+  if (!in) throw MeshFileError(index_path.string() + ": cannot be read");
+  std::vector<TileSetEntry> entries;
+  try {
+    const nlohmann::json index = nlohmann::json::parse(in);
+    for (const nlohmann::json& tile : index.at("tiles")) {
+      const std::vector<double> b = tile.at("bounds_m").get<std::vector<double>>();
+      if (b.size() != 6) throw MeshFileError("a tile's bounds_m is not six numbers");
+      TileSetEntry entry;
+      entry.x = tile.at("x").get<int32_t>();
+      entry.y = tile.at("y").get<int32_t>();
+      entry.bounds =
+          Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5]));
+      const nlohmann::json& file = tile.contains("ply") ? tile.at("ply") : tile.at("glb");
+      if (!file.is_string()) throw MeshFileError("a tile's file is not a string");
+      entry.file = file.get<std::string>();
+      entries.push_back(std::move(entry));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw MeshFileError(index_path.string() + ": not a tile set's index: " + e.what());
+  } catch (const MeshFileError& e) {
+    throw MeshFileError(index_path.string() + ": " + e.what());
+  }
+  return entries;
+}
 
 bool is_tile_set(const fs::path& dir) {
   std::error_code ec;

@@ -3,12 +3,27 @@
 /// hold a city: a tile set's folder (tile_set.hpp) a few tiles at a time, a tiled point file
 /// (the simulator's gt_points.ply) a tile at a time, any other mesh or cloud file whole.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "featsense/mesh/surface_regions.hpp"
 
 namespace featsense::viewer_export {
+
+/// One full-resolution tile of a tile set, as its index (tiles.json) lists it.
+struct TileSetEntry {
+  int32_t x = 0;
+  int32_t y = 0;
+  Eigen::AlignedBox3d bounds;  ///< map frame, metres
+  std::string file;            ///< PLY where written, else GLB; relative to the folder
+};
+
+/// The tiles of the tile set in `dir`. Throws MeshFileError naming tiles.json when it cannot be
+/// read or is not a tile set's index.
+std::vector<TileSetEntry> read_tile_set_index(const std::filesystem::path& dir);
 
 /// A tile set's full-resolution tiles (tiles.json; PLY where written, else GLB), the last
 /// `cached_tiles` kept in memory; the copies of a vertex on a cut between tiles come once

@@ -1,0 +1,146 @@
+// Navigation layers to files: one mesh, or a tile set's tiles each with its neighbours.
+
+#include "navigation_files.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "featsense/mesh/mesh_simplification.hpp"
+#include "featsense/viewer_export/mesh_nav_h5_io.hpp"
+#include "featsense/viewer_export/mesh_writer.hpp"
+#include "featsense/viewer_export/surface_file_regions.hpp"
+#include "json_output.hpp"
+#include "progress.hpp"
+
+namespace featsense::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Green (free) through yellow to red (cost just below 1); lethal vertices dark red.
+Eigen::Matrix<uint8_t, 3, 1> cost_colour(float cost) {
+  if (cost >= 1.0f) return {128, 0, 0};
+  const float c = std::clamp(cost, 0.0f, 1.0f);
+  const auto byte = [](float v) { return static_cast<uint8_t>(std::lround(v * 255.0f)); };
+  return c < 0.5f ? Eigen::Matrix<uint8_t, 3, 1>(byte(2.0f * c), 255, 0)
+                  : Eigen::Matrix<uint8_t, 3, 1>(255, byte(2.0f - 2.0f * c), 0);
+}
+
+/// The first `triangles` triangles of `whole` and the vertices they use, with their layers.
+void keep_first_triangles(const mesh::TriangleMesh& whole, const mesh::NavigationLayers& layers,
+                          std::size_t triangles, mesh::TriangleMesh* mesh,
+                          mesh::NavigationLayers* kept) {
+  std::vector<int> index(whole.vertices.size(), -1);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    Eigen::Vector3i tri;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(whole.triangles[t][k]);
+      if (index[v] < 0) {
+        index[v] = static_cast<int>(mesh->vertices.size());
+        mesh->vertices.push_back(whole.vertices[v]);
+        if (whole.has_normals()) mesh->normals.push_back(whole.normals[v]);
+        kept->inclination_deg.push_back(layers.inclination_deg[v]);
+        kept->roughness_deg.push_back(layers.roughness_deg[v]);
+        kept->height_diff_m.push_back(layers.height_diff_m[v]);
+        kept->cost.push_back(layers.cost[v]);
+      }
+      tri[k] = index[v];
+    }
+    mesh->triangles.push_back(tri);
+    kept->lethal_faces.push_back(layers.lethal_faces[t]);
+  }
+}
+
+}  // namespace
+
+std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& mesh,
+                                  const mesh::NavigationLayers& layers) {
+  if (!mesh.has_normals()) mesh.normals = mesh::vertex_normals(mesh);
+  viewer_export::MeshAttributes attributes;
+  attributes.scalars = {{"inclination_deg", layers.inclination_deg},
+                        {"roughness_deg", layers.roughness_deg},
+                        {"height_diff_m", layers.height_diff_m},
+                        {"cost", layers.cost}};
+  // Lethal per vertex too: the formats without face layers (PLY, glTF) carry it this way.
+  std::vector<float> lethal_vertices(mesh.vertices.size(), 0.0f);
+  std::vector<float> lethal_faces(layers.lethal_faces.size(), 0.0f);
+  std::size_t lethal_count = 0;
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (layers.lethal_faces[f] == 0) continue;
+    lethal_faces[f] = 1.0f;
+    ++lethal_count;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(mesh.triangles[f][k]);
+      if (layers.cost[v] >= 1.0f) lethal_vertices[v] = 1.0f;
+    }
+  }
+  attributes.scalars.push_back({"lethal", lethal_vertices});
+  for (const float cost : layers.cost) attributes.colors.push_back(cost_colour(cost));
+  if (viewer_export::mesh_extension(path) == ".h5") {
+    viewer_export::write_mesh_nav_h5(path, mesh, attributes, {{"lethal", lethal_faces}});
+  } else {
+    viewer_export::write_mesh(path, mesh, attributes);
+  }
+  return lethal_count;
+}
+
+nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::path& out_dir,
+                                      const std::string& extension,
+                                      const mesh::NavigationSettings& settings, bool quiet) {
+  const std::vector<viewer_export::TileSetEntry> tiles =
+      viewer_export::read_tile_set_index(tile_set_dir);
+  fs::create_directories(out_dir);
+  const double reach = settings.radius_m + 1.0;
+  nlohmann::json listed = nlohmann::json::array();
+  std::size_t triangles = 0;
+  std::size_t lethal = 0;
+  Progress progress("navmesh", tiles.size(), quiet);
+  for (std::size_t i = 0; i < tiles.size(); ++i) {
+    // The tile first, then its neighbours: welded, the tile's triangles stay the first ones.
+    std::vector<mesh::TriangleMesh> read;
+    read.push_back(viewer_export::read_mesh((tile_set_dir / tiles[i].file).string()));
+    Eigen::AlignedBox3d around = tiles[i].bounds;
+    around.min().head<2>().array() -= reach;
+    around.max().head<2>().array() += reach;
+    for (std::size_t j = 0; j < tiles.size(); ++j) {
+      if (j != i && tiles[j].bounds.intersects(around)) {
+        read.push_back(viewer_export::read_mesh((tile_set_dir / tiles[j].file).string()));
+      }
+    }
+    std::vector<const mesh::TriangleMesh*> parts;
+    for (const mesh::TriangleMesh& m : read) parts.push_back(&m);
+    // A vertex on a cut has its faces on both sides (for normals computed from faces) and its
+    // neighbours across it (roughness, height difference).
+    const mesh::TriangleMesh welded = mesh::weld_by_position(parts);
+    const std::size_t own = read.front().triangles.size();
+    read.clear();
+    const mesh::NavigationLayers layers = mesh::compute_navigation_layers(welded, settings);
+    mesh::TriangleMesh tile;
+    mesh::NavigationLayers tile_layers;
+    keep_first_triangles(welded, layers, own, &tile, &tile_layers);
+    const std::string name =
+        std::to_string(tiles[i].x) + "_" + std::to_string(tiles[i].y) + extension;
+    const std::size_t tile_lethal =
+        write_navigation_mesh((out_dir / name).string(), tile, tile_layers);
+    listed.push_back({{"x", tiles[i].x},
+                      {"y", tiles[i].y},
+                      {"file", name},
+                      {"triangles", own},
+                      {"lethal_triangles", tile_lethal}});
+    triangles += own;
+    lethal += tile_lethal;
+    progress.update(i + 1);
+  }
+  progress.finish();
+  const nlohmann::json index = {{"tile_set", tile_set_dir.string()},
+                                {"tiles", listed},
+                                {"triangles", triangles},
+                                {"lethal_triangles", lethal},
+                                {"max_slope_deg", settings.max_slope_deg},
+                                {"max_step_m", settings.max_step_m},
+                                {"radius_m", settings.radius_m}};
+  write_json(index, (out_dir / "navmesh.json").string());
+  return index;
+}
+
+}  // namespace featsense::app
