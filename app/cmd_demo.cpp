@@ -23,6 +23,7 @@ struct DemoOptions {
   std::string path = "walk";
   int frames = 0;         ///< 0: the whole path
   bool gt_poses = false;  ///< map with the true poses instead of the odometry's
+  bool tiles = false;     ///< the mesh as a tile set (a city's route), not one mesh
   std::optional<std::string> backend;
   std::optional<double> plan_height;  ///< topdown.png's cut
 };
@@ -41,7 +42,10 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
   std::printf("  mapped %d scans in %.1f s (%.1f scans/s, %s backend), %d map shifts\n",
               r["frames"].get<int>(), r["wall_s"].get<double>(), r["scans_per_s"].get<double>(),
               r["backend"].get<std::string>().c_str(), r["map"]["shifts"].get<int>());
-  if (r.contains("mesh")) {
+  if (r.contains("mesh") && r["mesh"].contains("tiles")) {
+    std::printf("  mesh: %zu triangles in %zu tiles\n", r["mesh"]["triangles"].get<size_t>(),
+                r["mesh"]["tiles"]["tiles"].get<size_t>());
+  } else if (r.contains("mesh")) {
     std::printf("  mesh: %zu triangles, %zu vertices\n", r["mesh"]["triangles"].get<size_t>(),
                 r["mesh"]["vertices"].get<size_t>());
   }
@@ -82,9 +86,9 @@ void print_summary(const DemoOptions& options, const MapOutcome& outcome) {
     }
   }
   std::printf("  files in %s:\n", out.string().c_str());
-  for (const char* name :
-       {"map.h5", "mesh.ply", "mesh.glb", "topdown.png", "mesh_error.ply", "mesh_error.glb",
-        "mesh_error.png", "trajectory_error.png", "trajectory.tum", "report.json", "report.html"}) {
+  for (const char* name : {"map.h5", "mesh.ply", "mesh.glb", "topdown.png", "mesh_error.ply",
+                           "mesh_error.glb", "mesh_error.png", "trajectory_error.png",
+                           "trajectory.tum", "report.json", "report.html", "tiles/tileset.json"}) {
     if (fs::exists(out / name)) std::printf("    %s\n", (out / name).string().c_str());
   }
   std::printf("    %s (the scene, the true path and the surface points the sensor saw)\n",
@@ -98,6 +102,7 @@ void run_demo(const DemoOptions& options, const CliContext& context) {
   map.overwrite = true;  // the demo's own folder: a second demo replaces the first
   map.print_summary = false;
   map.plan_height = options.plan_height;
+  map.tiles = options.tiles;
   // Bad --config / --set fail before the simulation.
   const config::Config config = map_config(map, context);
   SimulateOptions simulate;
@@ -156,6 +161,9 @@ Command register_demo(CLI::App& app, const CliContext& context) {
       ->check(CLI::Range(1, 100000));
   command->add_flag("--gt-poses", options->gt_poses,
                     "Map with the true poses instead of estimating them with the odometry");
+  command->add_flag("--tiles", options->tiles,
+                    "The mesh as a tile set (OUT/tiles/, 3D Tiles), made and compared with the "
+                    "truth a tile at a time: for the city's routes");
   add_config_option(*command, kBackendOption, options->backend);
   add_plan_height_option(*command, options->plan_height);
   return {command, [options, &context] { run_demo(*options, context); }};

@@ -87,6 +87,22 @@ TEST(CliDemo, GtPosesMapsWithTheTruth) {
   EXPECT_EQ(report["mesh"]["plan"]["cut_low_m"].get<double>(), 2.5);
 }
 
+TEST(CliDemo, WithTilesTheTileSetIsComparedWithTheTruth) {
+  const fs::path out = scratch_dir("cli_demo") / "tiles";
+  const CommandResult r =
+      run_featsense("demo -o " + out.string() + " --frames 4 --backend cpu --gt-poses --tiles");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("triangles in 4 tiles"), std::string::npos)
+      << r.output;  // a 20 m room about the origin
+  EXPECT_TRUE(fs::is_regular_file(out / "tiles" / "tileset.json"));
+  EXPECT_FALSE(fs::exists(out / "mesh.ply"));
+  const nlohmann::json report = read_json(out / "report.json");
+  ASSERT_TRUE(report["eval"].contains("mesh")) << report["eval"].dump();
+  EXPECT_LT(report["eval"]["mesh"]["accuracy"]["mean_abs"].get<double>(), 0.05);
+  EXPECT_GT(report["eval"]["mesh"]["completeness"]["0.10"].get<double>(), 0.5);
+  EXPECT_FALSE(fs::exists(out / "mesh_error.ply")) << "the error files colour one mesh";
+}
+
 // The error made visible: the distances as CloudCompare's scalar fields, and as colours a glTF
 // viewer shows, named in the report.
 TEST(CliDemo, WritesTheMeshErrorAsFieldsAndColours) {
