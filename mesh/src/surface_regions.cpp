@@ -37,6 +37,7 @@ SurfacePiece compact_piece(const TriangleMesh& whole, const std::vector<uint32_t
 
 MeshRegions::MeshRegions(const TriangleMesh& mesh, double cell_m) : mesh_(mesh), cell_m_(cell_m) {
   if (!(cell_m_ > 0.0)) throw MeshError("regions of a mesh: the cell must be positive");
+  validate(mesh, "a surface read by region");  // a non-finite vertex has no region
   bounds_.setEmpty();
   for (const Eigen::Vector3f& v : mesh.vertices) bounds_.extend(v.cast<double>());
   if (bounds_.isEmpty()) return;

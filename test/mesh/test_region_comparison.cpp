@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -188,6 +189,9 @@ TEST(RegionComparison, EmptyOrDegenerateInputsAreErrors) {
   flat.triangles = {{0, 1, 2}, {1, 2, 0}, {0, 0, 1}};
   EXPECT_THROW(mesh::compare_by_region(mesh::MeshRegions(truth), mesh::MeshRegions(flat)),
                mesh::MeshError);
+  mesh::TriangleMesh broken = truth;
+  broken.vertices[7].y() = std::nanf("");
+  EXPECT_THROW(mesh::MeshRegions{broken}, mesh::MeshError);
   mesh::RegionComparisonSettings zero;
   zero.region_size_m = 0.0;
   EXPECT_THROW(

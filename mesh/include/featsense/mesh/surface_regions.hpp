@@ -42,7 +42,8 @@ class SurfaceRegions {
 };
 
 /// A mesh (or cloud) in memory, its triangles (points) bucketed on an x, y grid of `cell_m`.
-/// Keeps a reference: `mesh` must outlive it.
+/// Keeps a reference: `mesh` must outlive it. Throws MeshError for an invalid mesh (validate:
+/// a non-finite coordinate, an index out of range).
 class MeshRegions final : public SurfaceRegions {
  public:
   explicit MeshRegions(const TriangleMesh& mesh, double cell_m = 25.0);
