@@ -87,6 +87,33 @@ mesh::TriangleMesh weld_within(const mesh::TriangleMesh& mesh, double tolerance_
   return out;
 }
 
+/// The triangles of `mesh` whose bounding box meets `box`, with the vertices they use.
+mesh::TriangleMesh triangles_meeting(const mesh::TriangleMesh& mesh,
+                                     const Eigen::AlignedBox3d& box) {
+  mesh::TriangleMesh out;
+  std::vector<int> index(mesh.vertices.size(), -1);
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    Eigen::AlignedBox3d extent;
+    extent.setEmpty();
+    for (int k = 0; k < 3; ++k) {
+      extent.extend(mesh.vertices[static_cast<std::size_t>(t[k])].cast<double>());
+    }
+    if (!extent.intersects(box)) continue;
+    Eigen::Vector3i kept;
+    for (int k = 0; k < 3; ++k) {
+      int& i = index[static_cast<std::size_t>(t[k])];
+      if (i < 0) {
+        i = static_cast<int>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(t[k])]);
+        if (mesh.has_normals()) out.normals.push_back(mesh.normals[static_cast<std::size_t>(t[k])]);
+      }
+      kept[k] = i;
+    }
+    out.triangles.push_back(kept);
+  }
+  return out;
+}
+
 class TileSetRegions final : public mesh::SurfaceRegions {
  public:
   TileSetRegions(const fs::path& dir, std::size_t cached_tiles)
@@ -103,13 +130,15 @@ class TileSetRegions final : public mesh::SurfaceRegions {
   bool is_point_cloud() const override { return false; }
 
   mesh::SurfacePiece read(const Eigen::AlignedBox3d& box) const override {
-    std::vector<const mesh::TriangleMesh*> parts;
-    std::vector<std::shared_ptr<const mesh::TriangleMesh>> held;
+    // Only the triangles that meet the box: a region's column takes a part of each of up to
+    // four tiles, and welding and searching whole tiles cost four times as much.
+    std::vector<mesh::TriangleMesh> clipped;
     for (std::size_t i = 0; i < tiles_.size(); ++i) {
       if (!tiles_[i].bounds.intersects(box)) continue;
-      held.push_back(tile(i));
-      parts.push_back(held.back().get());
+      clipped.push_back(triangles_meeting(*tile(i), box));
     }
+    std::vector<const mesh::TriangleMesh*> parts;
+    for (const mesh::TriangleMesh& part : clipped) parts.push_back(&part);
     mesh::SurfacePiece piece;
     if (parts.empty()) return piece;
     // The tiles' copies of a vertex on a cut are one vertex, as in the whole map's mesh: the
