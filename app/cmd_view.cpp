@@ -45,6 +45,9 @@ void run_view(const ViewOptions& options, const CliContext& context) {
   }
   ViewServer& server = *server_owner;
   const int port = server.bind(options.host, options.port);
+  // Before the URL is printed: a Ctrl+C the moment it appears (a script that reads the URL
+  // and stops the server) closes the server cleanly instead of killing the process.
+  const StopSignal stop_signal("closing the viewer's server");
   if (!context.quiet) {
     std::printf("featsense view: %s loaded in %.1f s\n", loaded.c_str(),
                 std::chrono::duration<double>(Clock::now() - start).count());
@@ -54,7 +57,6 @@ void run_view(const ViewOptions& options, const CliContext& context) {
   if (!context.quiet) std::printf("Ctrl+C stops the server\n");
   std::fflush(stdout);
 
-  const StopSignal stop_signal("closing the viewer's server");
   std::atomic<bool> served{true};
   std::thread listener([&] { served = server.run(); });
   while (!stop_signal.requested() && served)
