@@ -353,6 +353,11 @@ PassResult MapPass::close() {
     throw;
   }
   closed_ = true;
+  // The local map, its integrator, the refinement's and the loops' clouds are of no more use:
+  // a second pass runs while this one's result is kept, and must not hold them twice.
+  store_.reset();
+  refiner_.reset();
+  loops_.reset();
   return std::move(result_);
 }
 
