@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <numeric>
 
 #include "featsense/mesh/mesh_simplification.hpp"
 #include "featsense/viewer_export/mesh_nav_h5_io.hpp"
@@ -30,25 +32,18 @@ Eigen::Matrix<uint8_t, 3, 1> cost_colour(float cost) {
 void keep_first_triangles(const mesh::TriangleMesh& whole, const mesh::NavigationLayers& layers,
                           std::size_t triangles, mesh::TriangleMesh* mesh,
                           mesh::NavigationLayers* kept) {
-  std::vector<int> index(whole.vertices.size(), -1);
-  for (std::size_t t = 0; t < triangles; ++t) {
-    Eigen::Vector3i tri;
-    for (int k = 0; k < 3; ++k) {
-      const auto v = static_cast<std::size_t>(whole.triangles[t][k]);
-      if (index[v] < 0) {
-        index[v] = static_cast<int>(mesh->vertices.size());
-        mesh->vertices.push_back(whole.vertices[v]);
-        if (whole.has_normals()) mesh->normals.push_back(whole.normals[v]);
-        kept->inclination_deg.push_back(layers.inclination_deg[v]);
-        kept->roughness_deg.push_back(layers.roughness_deg[v]);
-        kept->height_diff_m.push_back(layers.height_diff_m[v]);
-        kept->cost.push_back(layers.cost[v]);
-      }
-      tri[k] = index[v];
-    }
-    mesh->triangles.push_back(tri);
-    kept->lethal_faces.push_back(layers.lethal_faces[t]);
+  std::vector<uint32_t> first(triangles);
+  std::iota(first.begin(), first.end(), 0u);
+  std::vector<uint64_t> source;
+  *mesh = mesh::triangle_subset(whole, first, &source);
+  for (uint64_t v : source) {
+    kept->inclination_deg.push_back(layers.inclination_deg[v]);
+    kept->roughness_deg.push_back(layers.roughness_deg[v]);
+    kept->height_diff_m.push_back(layers.height_diff_m[v]);
+    kept->cost.push_back(layers.cost[v]);
   }
+  kept->lethal_faces.assign(layers.lethal_faces.begin(),
+                            layers.lethal_faces.begin() + static_cast<std::ptrdiff_t>(triangles));
 }
 
 }  // namespace
@@ -87,8 +82,10 @@ std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& m
 nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::path& out_dir,
                                       const std::string& extension,
                                       const mesh::NavigationSettings& settings, bool quiet) {
-  const std::vector<viewer_export::TileSetEntry> tiles =
-      viewer_export::read_tile_set_index(tile_set_dir);
+  // A tile and its (up to) eight neighbours at a time; the reader's cache keeps the tiles of
+  // the last few, so that a tile is mostly read once, not nine times.
+  const viewer_export::TileSetReader reader(tile_set_dir);
+  const std::vector<viewer_export::TileSetEntry>& tiles = reader.tiles();
   fs::create_directories(out_dir);
   const double reach = settings.radius_m + 1.0;
   nlohmann::json listed = nlohmann::json::array();
@@ -97,22 +94,19 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   Progress progress("navmesh", tiles.size(), quiet);
   for (std::size_t i = 0; i < tiles.size(); ++i) {
     // The tile first, then its neighbours: welded, the tile's triangles stay the first ones.
-    std::vector<mesh::TriangleMesh> read;
-    read.push_back(viewer_export::read_mesh((tile_set_dir / tiles[i].file).string()));
+    std::vector<std::shared_ptr<const mesh::TriangleMesh>> read{reader.tile(i)};
     Eigen::AlignedBox3d around = tiles[i].bounds;
     around.min().head<2>().array() -= reach;
     around.max().head<2>().array() += reach;
     for (std::size_t j = 0; j < tiles.size(); ++j) {
-      if (j != i && tiles[j].bounds.intersects(around)) {
-        read.push_back(viewer_export::read_mesh((tile_set_dir / tiles[j].file).string()));
-      }
+      if (j != i && tiles[j].bounds.intersects(around)) read.push_back(reader.tile(j));
     }
     std::vector<const mesh::TriangleMesh*> parts;
-    for (const mesh::TriangleMesh& m : read) parts.push_back(&m);
+    for (const auto& m : read) parts.push_back(m.get());
     // A vertex on a cut has its faces on both sides (for normals computed from faces) and its
     // neighbours across it (roughness, height difference).
     const mesh::TriangleMesh welded = mesh::weld_by_position(parts);
-    const std::size_t own = read.front().triangles.size();
+    const std::size_t own = read.front()->triangles.size();
     read.clear();
     const mesh::NavigationLayers layers = mesh::compute_navigation_layers(welded, settings);
     mesh::TriangleMesh tile;

@@ -7,33 +7,6 @@
 #include <cmath>
 
 namespace featsense::mesh {
-namespace {
-
-/// The vertices `used` (indices into `vertices`, ascending) as a compact piece with the
-/// triangles renumbered.
-SurfacePiece compact_piece(const TriangleMesh& whole, const std::vector<uint32_t>& triangles,
-                           std::vector<uint64_t> used) {
-  SurfacePiece piece;
-  std::sort(used.begin(), used.end());
-  used.erase(std::unique(used.begin(), used.end()), used.end());
-  piece.mesh.vertices.reserve(used.size());
-  for (uint64_t v : used) piece.mesh.vertices.push_back(whole.vertices[v]);
-  if (whole.has_normals()) {
-    for (uint64_t v : used) piece.mesh.normals.push_back(whole.normals[v]);
-  }
-  auto local = [&](int v) {
-    return static_cast<int>(std::lower_bound(used.begin(), used.end(), static_cast<uint64_t>(v)) -
-                            used.begin());
-  };
-  for (uint32_t t : triangles) {
-    const Eigen::Vector3i& tri = whole.triangles[t];
-    piece.mesh.triangles.emplace_back(local(tri[0]), local(tri[1]), local(tri[2]));
-  }
-  piece.source_index = std::move(used);
-  return piece;
-}
-
-}  // namespace
 
 MeshRegions::MeshRegions(const TriangleMesh& mesh, double cell_m) : mesh_(mesh), cell_m_(cell_m) {
   if (!(cell_m_ > 0.0)) throw MeshError("regions of a mesh: the cell must be positive");
@@ -131,11 +104,11 @@ SurfacePiece MeshRegions::read(const Eigen::AlignedBox3d& box) const {
   std::sort(found.begin(), found.end());
   found.erase(std::unique(found.begin(), found.end()), found.end());
   std::vector<uint32_t> triangles;
-  std::vector<uint64_t> used;
+  std::vector<size_t> loose;
   for (uint32_t i : found) {
     if (i >= mesh_.triangles.size()) {
       const size_t v = vertex_of(i);
-      if (box.contains(mesh_.vertices[v].cast<double>())) used.push_back(v);
+      if (box.contains(mesh_.vertices[v].cast<double>())) loose.push_back(v);
       continue;
     }
     Eigen::AlignedBox3d extent;
@@ -143,11 +116,17 @@ SurfacePiece MeshRegions::read(const Eigen::AlignedBox3d& box) const {
     for (int k = 0; k < 3; ++k) {
       extent.extend(mesh_.vertices[static_cast<size_t>(mesh_.triangles[i][k])].cast<double>());
     }
-    if (!extent.intersects(box)) continue;
-    triangles.push_back(i);
-    for (int k = 0; k < 3; ++k) used.push_back(static_cast<uint64_t>(mesh_.triangles[i][k]));
+    if (extent.intersects(box)) triangles.push_back(i);
   }
-  return compact_piece(mesh_, triangles, std::move(used));
+  SurfacePiece piece;
+  piece.mesh = triangle_subset(mesh_, triangles, &piece.source_index);
+  // The vertices in no triangle (of a cloud, all) after those of the triangles.
+  for (size_t v : loose) {
+    piece.mesh.vertices.push_back(mesh_.vertices[v]);
+    if (mesh_.has_normals()) piece.mesh.normals.push_back(mesh_.normals[v]);
+    piece.source_index.push_back(v);
+  }
+  return piece;
 }
 
 SurfacePiece PointFileRegions::read(const Eigen::AlignedBox3d& box) const {

@@ -139,4 +139,26 @@ double surface_area_m2(const TriangleMesh& mesh) {
   return area;
 }
 
+TriangleMesh triangle_subset(const TriangleMesh& mesh, const std::vector<uint32_t>& which,
+                             std::vector<uint64_t>* source_vertex) {
+  TriangleMesh out;
+  std::vector<int> index(mesh.vertices.size(), -1);
+  const bool normals = mesh.has_normals();
+  for (uint32_t t : which) {
+    Eigen::Vector3i kept;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<size_t>(mesh.triangles[t][k]);
+      if (index[v] < 0) {
+        index[v] = static_cast<int>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[v]);
+        if (normals) out.normals.push_back(mesh.normals[v]);
+        if (source_vertex) source_vertex->push_back(v);
+      }
+      kept[k] = index[v];
+    }
+    out.triangles.push_back(kept);
+  }
+  return out;
+}
+
 }  // namespace featsense::mesh

@@ -136,5 +136,23 @@ TEST(TriangleMesh, ValidateChecksTheParts) {
       << validation_error(bright);
 }
 
+TEST(TriangleMesh, ASubsetKeepsItsTrianglesAndOnlyTheirVertices) {
+  mesh::TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {5, 5, 5}};
+  m.normals.assign(5, Eigen::Vector3f::UnitZ());
+  m.normals[3] = Eigen::Vector3f::UnitX();
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  std::vector<uint64_t> source;
+  const mesh::TriangleMesh sub = mesh::triangle_subset(m, {1}, &source);
+  // Vertices 0, 2, 3 in the order of first use; 1 and the loose 4 left out.
+  EXPECT_EQ(source, (std::vector<uint64_t>{0, 2, 3}));
+  ASSERT_EQ(sub.vertices.size(), 3u);
+  EXPECT_EQ(sub.vertices[2], m.vertices[3]);
+  EXPECT_EQ(sub.normals[2], Eigen::Vector3f::UnitX());
+  ASSERT_EQ(sub.triangles.size(), 1u);
+  EXPECT_EQ(sub.triangles[0], Eigen::Vector3i(0, 1, 2));
+  EXPECT_TRUE(mesh::triangle_subset(m, {}).vertices.empty());
+}
+
 }  // namespace
 }  // namespace featsense::test

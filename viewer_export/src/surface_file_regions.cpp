@@ -90,39 +90,25 @@ mesh::TriangleMesh weld_within(const mesh::TriangleMesh& mesh, double tolerance_
 /// The triangles of `mesh` whose bounding box meets `box`, with the vertices they use.
 mesh::TriangleMesh triangles_meeting(const mesh::TriangleMesh& mesh,
                                      const Eigen::AlignedBox3d& box) {
-  mesh::TriangleMesh out;
-  std::vector<int> index(mesh.vertices.size(), -1);
-  for (const Eigen::Vector3i& t : mesh.triangles) {
+  std::vector<uint32_t> meeting;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     Eigen::AlignedBox3d extent;
     extent.setEmpty();
     for (int k = 0; k < 3; ++k) {
-      extent.extend(mesh.vertices[static_cast<std::size_t>(t[k])].cast<double>());
+      extent.extend(mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][k])].cast<double>());
     }
-    if (!extent.intersects(box)) continue;
-    Eigen::Vector3i kept;
-    for (int k = 0; k < 3; ++k) {
-      int& i = index[static_cast<std::size_t>(t[k])];
-      if (i < 0) {
-        i = static_cast<int>(out.vertices.size());
-        out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(t[k])]);
-        if (mesh.has_normals()) out.normals.push_back(mesh.normals[static_cast<std::size_t>(t[k])]);
-      }
-      kept[k] = i;
-    }
-    out.triangles.push_back(kept);
+    if (extent.intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
   }
-  return out;
+  return mesh::triangle_subset(mesh, meeting);
 }
 
 class TileSetRegions final : public mesh::SurfaceRegions {
  public:
-  TileSetRegions(const fs::path& dir, std::size_t cached_tiles)
-      : dir_(dir), cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {
+  TileSetRegions(const fs::path& dir, std::size_t cached_tiles) : reader_(dir, cached_tiles) {
     bounds_.setEmpty();
-    for (TileSetEntry& entry : read_tile_set_index(dir)) {
+    for (const TileSetEntry& entry : reader_.tiles()) {
       bounds_.extend(entry.bounds);
       glb_ = glb_ || mesh_extension(entry.file) != ".ply";
-      tiles_.push_back({entry.bounds, std::move(entry.file)});
     }
   }
 
@@ -133,9 +119,9 @@ class TileSetRegions final : public mesh::SurfaceRegions {
     // Only the triangles that meet the box: a region's column takes a part of each of up to
     // four tiles, and welding and searching whole tiles cost four times as much.
     std::vector<mesh::TriangleMesh> clipped;
-    for (std::size_t i = 0; i < tiles_.size(); ++i) {
-      if (!tiles_[i].bounds.intersects(box)) continue;
-      clipped.push_back(triangles_meeting(*tile(i), box));
+    for (std::size_t i = 0; i < reader_.tiles().size(); ++i) {
+      if (!reader_.tiles()[i].bounds.intersects(box)) continue;
+      clipped.push_back(triangles_meeting(*reader_.tile(i), box));
     }
     std::vector<const mesh::TriangleMesh*> parts;
     for (const mesh::TriangleMesh& part : clipped) parts.push_back(&part);
@@ -149,37 +135,9 @@ class TileSetRegions final : public mesh::SurfaceRegions {
   }
 
  private:
-  struct Tile {
-    Eigen::AlignedBox3d bounds;
-    std::string file;  ///< relative to the folder
-  };
-
-  std::shared_ptr<const mesh::TriangleMesh> tile(std::size_t i) const {
-    const auto found = cache_.find(i);
-    if (found != cache_.end()) {
-      recent_.remove(i);
-      recent_.push_front(i);
-      return found->second;
-    }
-    auto loaded =
-        std::make_shared<const mesh::TriangleMesh>(read_mesh((dir_ / tiles_[i].file).string()));
-    cache_[i] = loaded;
-    recent_.push_front(i);
-    while (recent_.size() > cached_tiles_) {
-      cache_.erase(recent_.back());
-      recent_.pop_back();
-    }
-    return loaded;
-  }
-
-  fs::path dir_;
+  TileSetReader reader_;
   bool glb_ = false;  ///< some tiles are GLB only
-  std::size_t cached_tiles_;
-  std::vector<Tile> tiles_;
   Eigen::AlignedBox3d bounds_;
-  // The cache is not the tile set's state: reads stay const.
-  mutable std::map<std::size_t, std::shared_ptr<const mesh::TriangleMesh>> cache_;
-  mutable std::list<std::size_t> recent_;  ///< most recent first
 };
 
 }  // namespace
@@ -210,6 +168,29 @@ std::vector<TileSetEntry> read_tile_set_index(const fs::path& dir) {
     throw MeshFileError(index_path.string() + ": " + e.what());
   }
   return entries;
+}
+
+TileSetReader::TileSetReader(fs::path dir, std::size_t cached_tiles)
+    : dir_(std::move(dir)),
+      tiles_(read_tile_set_index(dir_)),
+      cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {}
+
+std::shared_ptr<const mesh::TriangleMesh> TileSetReader::tile(std::size_t i) const {
+  const auto found = cache_.find(i);
+  if (found != cache_.end()) {
+    recent_.remove(i);
+    recent_.push_front(i);
+    return found->second;
+  }
+  auto loaded =
+      std::make_shared<const mesh::TriangleMesh>(read_mesh((dir_ / tiles_.at(i).file).string()));
+  cache_[i] = loaded;
+  recent_.push_front(i);
+  while (recent_.size() > cached_tiles_) {
+    cache_.erase(recent_.back());
+    recent_.pop_back();
+  }
+  return loaded;
 }
 
 bool is_tile_set(const fs::path& dir) {

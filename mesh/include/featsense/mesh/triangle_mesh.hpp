@@ -85,4 +85,10 @@ void validate(const TriangleMesh& mesh, const std::string& what);
 /// Sum of the triangles' areas, square metres.
 double surface_area_m2(const TriangleMesh& mesh);
 
+/// The triangles `which` (indices into mesh.triangles, in that order) with the vertices they
+/// use, renumbered in the order of first use; normals kept where the mesh has them, parts
+/// dropped. Where given, `source_vertex` receives each kept vertex's index in `mesh`.
+TriangleMesh triangle_subset(const TriangleMesh& mesh, const std::vector<uint32_t>& which,
+                             std::vector<uint64_t>* source_vertex = nullptr);
+
 }  // namespace featsense::mesh

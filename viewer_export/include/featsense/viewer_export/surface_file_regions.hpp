@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <list>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +26,24 @@ struct TileSetEntry {
 /// The tiles of the tile set in `dir`. Throws MeshFileError naming tiles.json when it cannot be
 /// read or is not a tile set's index.
 std::vector<TileSetEntry> read_tile_set_index(const std::filesystem::path& dir);
+
+/// A tile set's full-resolution tiles read from disk as they are asked for, the last
+/// `cached_tiles` kept in memory. Throws MeshFileError naming the file that cannot be read.
+class TileSetReader {
+ public:
+  explicit TileSetReader(std::filesystem::path dir, std::size_t cached_tiles = 16);
+  const std::vector<TileSetEntry>& tiles() const { return tiles_; }
+  /// Tile `i` of tiles(), from the cache or from its file.
+  std::shared_ptr<const mesh::TriangleMesh> tile(std::size_t i) const;
+
+ private:
+  std::filesystem::path dir_;
+  std::vector<TileSetEntry> tiles_;
+  std::size_t cached_tiles_;
+  // The cache is not the tile set's state: reading stays const.
+  mutable std::map<std::size_t, std::shared_ptr<const mesh::TriangleMesh>> cache_;
+  mutable std::list<std::size_t> recent_;  ///< most recent first
+};
 
 /// A tile set's full-resolution tiles (tiles.json; PLY where written, else GLB), the last
 /// `cached_tiles` kept in memory; the copies of a vertex on a cut between tiles come once
