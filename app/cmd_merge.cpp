@@ -62,6 +62,7 @@ void run_merge(const MergeOptions& options, const CliContext& context) {
   report["fitness_m"] = merged.placement->fitness_m;
   report["agreeing"] = merged.placement->agreeing;
   report["links"] = session_links_json(merged.links);
+  report["reintegration"] = reintegration_json(merged.reintegration);
   // Each session's poses in the merged map, beside it: C.session0.tum, ...
   for (size_t k = 0; k < merged.sessions.size(); ++k) {
     slam::write_tum(

@@ -107,6 +107,23 @@ nlohmann::json relocalization_json(const mapping::RelocalizationReport& report) 
       {"moved_max_deg", report.earlier_moved_max_deg},
       {"mapped_again", report.earlier.kind == mapping::EarlierSessions::kMappedAgain}};
   if (!report.earlier.reason.empty()) out["earlier_sessions"]["why"] = report.earlier.reason;
+  if (report.reintegration)
+    out["earlier_sessions"]["reintegration"] = reintegration_json(*report.reintegration);
+  return out;
+}
+
+nlohmann::json reintegration_json(const mapping::ReintegrationCounts& counts) {
+  nlohmann::json out = {{"whole", counts.whole},
+                        {"scans", counts.scans},
+                        {"scans_moved", counts.scans_moved},
+                        {"scans_integrated_again", counts.scans_reintegrated},
+                        {"chunks_before", counts.chunks_before},
+                        {"chunks_made_again", counts.chunks_changed},
+                        {"chunks_kept", counts.chunks_kept},
+                        {"plan_s", counts.plan_s},
+                        {"integrate_s", counts.reintegrate_s},
+                        {"assemble_s", counts.assemble_s}};
+  if (!counts.why.empty()) out["why_whole"] = counts.why;
   return out;
 }
 

@@ -21,4 +21,7 @@ nlohmann::json tried_json(const slam::loops::RelocalizationCounts& counts);
 /// report.json's "relocalization" of `featsense map --continue`.
 nlohmann::json relocalization_json(const mapping::RelocalizationReport& report);
 
+/// What was integrated again where earlier sessions were mapped again, and what was kept.
+nlohmann::json reintegration_json(const mapping::ReintegrationCounts& counts);
+
 }  // namespace featsense::app

@@ -243,6 +243,7 @@ std::vector<KeySpec> make_specs() {
       bool_key("map.vertical_interpolation", &Config::map, &MapConfig::vertical_interpolation),
       bool_key("map.sparse_carving", &Config::map, &MapConfig::sparse_carving),
       bool_key("map.carve_free_space", &Config::map, &MapConfig::carve_free_space),
+      bool_key("map.keep_unmoved", &Config::map, &MapConfig::keep_unmoved),
       number_key("map.flush_interval", &Config::map, &MapConfig::flush_interval_s, {1.0, 86400.0}),
       backend_key(),
       integer_key("features.neighbours", &Config::features, &FeaturesConfig::neighbours, 1, 20),

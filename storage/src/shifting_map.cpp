@@ -169,9 +169,15 @@ tsdf::Vec3 ShiftingMap::centre_m() const {
   return 0.5f * (lo + hi);
 }
 
+tsdf::Index3 followed_origin(const tsdf::LocalMapGeometry& geometry, tsdf::Vec3 sensor_m,
+                             double shift_threshold_m) {
+  const tsdf::Vec3 centre = 0.5f * (geometry.min_corner() + geometry.max_corner());
+  if (tsdf::norm(sensor_m - centre) <= shift_threshold_m) return geometry.origin;
+  return tsdf::centred_origin(geometry, sensor_m);
+}
+
 bool ShiftingMap::follow(tsdf::Vec3 sensor_m) {
-  if (tsdf::norm(sensor_m - centre_m()) <= shift_threshold_m_) return false;
-  const Index3 origin = tsdf::centred_origin(map_.geometry(), sensor_m);
+  const Index3 origin = followed_origin(map_.geometry(), sensor_m, shift_threshold_m_);
   const Index3 now = map_.geometry().origin;
   if (origin.x == now.x && origin.y == now.y && origin.z == now.z) return false;
   move_to(origin);

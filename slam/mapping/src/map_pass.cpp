@@ -20,11 +20,6 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-tsdf::Vec3 position_of(const Eigen::Isometry3d& pose) {
-  const Eigen::Vector3d t = pose.translation();
-  return {static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())};
-}
-
 }  // namespace
 
 /// The map a pass writes: the store, the TSDF backend (made when the first scan arrives) and
@@ -162,7 +157,9 @@ void MapPass::count_dropped(uint64_t sequence, ScanDrop why) {
 
 std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed, bool skip_integration) {
   const Clock::time_point start = Clock::now();
-  const bool integrates = settings_.integrate && !skip_integration;
+  const bool integrates = settings_.integrate && !skip_integration &&
+                          (!settings_.reintegrate ||
+                           settings_.reintegrate->origins.count(placed.placement.stamp_ns) > 0);
   if (const std::optional<double> ms =
           latency_.since_ready(placed.placement.sequence, !integrates)) {
     result_.timings.latency_final_pose_ms.push_back(*ms);
@@ -178,9 +175,9 @@ std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed, bool skip_integ
 }
 
 void MapPass::open_map(const LocatedScan& first) {
-  store_->integrator =
-      tsdf::make_integrator(config_.map.backend, store_->tsdf,
-                            position_of(first.placement.T_map_sensor), &result_.backend_reason);
+  store_->integrator = tsdf::make_integrator(config_.map.backend, store_->tsdf,
+                                             local_map_anchor(first.placement.T_map_sensor),
+                                             &result_.backend_reason);
   events_.info("TSDF: " + result_.backend_reason);
   store_->map = std::make_unique<storage::ShiftingMap>(*store_->integrator, *store_->files.store,
                                                        config_.map.shift_threshold_m);
@@ -188,9 +185,10 @@ void MapPass::open_map(const LocatedScan& first) {
 
 void MapPass::integrate(LocatedScan scan) {
   if (preview_) preview_->add_pose(scan.placement.stamp_ns, scan.placement.T_map_sensor);
-  if (settings_.integrate && !scan.integrate) {  // skipped to keep up: the pose only
+  if (settings_.integrate && !scan.integrate) {  // skipped to keep up, or kept: the pose only
     result_.poses.push_back(scan.placement.stamp_ns, scan.placement.T_map_sensor);
-    ++result_.real_time.integrations_skipped;
+    ++(settings_.reintegrate ? result_.frames_not_reintegrated
+                             : result_.real_time.integrations_skipped);
     update_preview(false);
     return;
   }
@@ -204,7 +202,13 @@ void MapPass::integrate(LocatedScan scan) {
   if (!store_->map) open_map(scan);
   storage::ShiftingMap& map = *store_->map;
   Clock::time_point start = Clock::now();
-  map.follow(position_of(scan.placement.T_map_sensor));
+  if (settings_.reintegrate) {
+    const tsdf::Index3 origin = settings_.reintegrate->origins.at(scan.placement.stamp_ns);
+    const tsdf::Index3 now = map.integrator().geometry().origin;
+    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) map.move_to(origin);
+  } else {
+    map.follow(local_map_anchor(scan.placement.T_map_sensor));
+  }
   result_.timings.shift_ms.push_back(ms_since(start));
 
   start = Clock::now();

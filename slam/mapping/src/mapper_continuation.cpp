@@ -257,7 +257,8 @@ void Mapper::Continuation::map_placed(Mapper& mapper, MapResult& result, const P
           .replace_extension(".rebuilt" + request.map_path.extension().string());
   try {
     build_then_replace(rebuilt, request.map_path, [&] {
-      remap_sessions(
+      result.relocalization->reintegration = remap_sessions_where_moved(
+          saved_,
           session_remaps(saved_, placed.keyframes, 0, 0, Eigen::Isometry3d::Identity(),
                          linked_poses,
                          "; moved by the links of session " + std::to_string(placed.session_id)),

@@ -89,7 +89,8 @@ MergeResult merge_maps(const std::string& first_path, const std::string& second_
   const PassSettings replay = pass_settings(config);
   const std::filesystem::path partial = std::filesystem::path(output.string() + ".partial");
   build_then_replace(partial, output, [&] {
-    remap_sessions(result.sessions, partial, replay, config, first.metadata.sensor, events);
+    result.reintegration = remap_sessions_where_moved(first, result.sessions, partial, replay,
+                                                      config, first.metadata.sensor, events);
   });
   return result;
 }

@@ -59,10 +59,19 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
 
 void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
                     const PassSettings& replay, const config::Config& config,
-                    const std::string& sensor_name, const RunEvents& events) {
+                    const std::string& sensor_name, const RunEvents& events,
+                    const std::vector<ScanReintegration>* only) {
   for (size_t s = 0; s < sessions.size(); ++s) {
     const SessionRemap& session = sessions[s];
-    events.info("mapping " + session.description.input + " again with its corrected poses");
+    PassSettings settings = replay;
+    if (only) settings.reintegrate = &only->at(s);
+    if (only) {
+      events.info("integrating " + std::to_string(settings.reintegrate->origins.size()) + " of " +
+                  std::to_string(session.poses.size()) + " scans of " + session.description.input +
+                  " again");
+    } else {
+      events.info("mapping " + session.description.input + " again with its corrected poses");
+    }
     const std::unique_ptr<slam::ScanSource> source =
         open_recording(session.description.input, config);
     const std::unique_ptr<slam::ScanLocator> locator =
@@ -73,7 +82,7 @@ void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& i
       pipeline.range.last_stamp_ns = session.poses.stamps_ns.back();
     }
     const PassResult pass = run_pass(
-        *source, *locator, replay, config,
+        *source, *locator, settings, config,
         {into, sensor_name, s == 0 ? std::nullopt : std::optional<std::string>(into.string()), true,
          session.description, &session.keyframes},
         events, pipeline);

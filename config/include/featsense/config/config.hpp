@@ -55,6 +55,10 @@ struct MapConfig {
   bool sparse_carving = true;
   /// Rays carve the free space in front of their surfaces (false: the band only).
   bool carve_free_space = true;
+  /// Where corrected poses make a saved map again (links to a continuing recording, merge):
+  /// integrate again only where scans moved, keep the other chunks byte for byte (false:
+  /// every scan again).
+  bool keep_unmoved = true;
   /// Seconds between two writes of the local map into the store during a run.
   double flush_interval_s = 30.0;
   Backend backend = Backend::kAuto;

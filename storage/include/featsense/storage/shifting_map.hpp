@@ -76,6 +76,13 @@ class ShiftingMap {
   std::vector<uint32_t> read_outside_;
 };
 
+/// Where follow() puts a local map of `geometry` for a sensor at `sensor_m`: the origin of
+/// the map centred on the sensor's brick once the sensor is more than `shift_threshold_m`
+/// from the map's centre, else `geometry.origin`. A plan of where each scan's local map will
+/// lie (mapping/reintegration_plan.hpp) follows the same rule.
+tsdf::Index3 followed_origin(const tsdf::LocalMapGeometry& geometry, tsdf::Vec3 sensor_m,
+                             double shift_threshold_m);
+
 /// A 64-bit digest of a chunk's voxels, to tell whether a chunk changed since it was written.
 uint64_t chunk_digest(const Chunk& chunk);
 

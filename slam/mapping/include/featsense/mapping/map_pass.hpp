@@ -22,6 +22,7 @@
 #include "featsense/mapping/map_preview.hpp"
 #include "featsense/mapping/map_sessions.hpp"
 #include "featsense/mapping/pass_result.hpp"
+#include "featsense/mapping/reintegration_plan.hpp"
 #include "featsense/mapping/run_events.hpp"
 #include "featsense/mapping/scan_latency.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
@@ -65,6 +66,10 @@ struct PassSettings {
   /// The map as it is made, re-meshed where it changed about every interval (map_preview.hpp);
   /// none: no preview.
   std::optional<MapPreviewSettings> preview;
+  /// Poses corrected: only these scans are integrated again, each with the local map where a
+  /// full re-map would have it (reintegration_plan.hpp); the others keep their poses only.
+  /// Null: every scan, the local map following the sensor. Must outlive the pass.
+  const ScanReintegration* reintegrate = nullptr;
 };
 
 /// map.flush_interval and sensor.drop_mixed_pixels of `config`: a pass that integrates, with

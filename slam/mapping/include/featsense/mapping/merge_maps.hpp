@@ -25,6 +25,8 @@ struct MergeResult {
   SessionLinks links;
   /// Every session of the merged map, A's then B's, with its final poses.
   std::vector<SessionRemap> sessions;
+  /// A's sessions mapped again where they moved, B's all (remap_sessions_where_moved).
+  ReintegrationCounts reintegration;
 };
 
 /// Reads A and B (each must keep keyframes and name inputs that can be read again), places B

@@ -63,6 +63,8 @@ struct PassResult {
   /// Scans integrated into the map (or placed, without a map); not those whose integration
   /// the real-time policy skipped (real_time.integrations_skipped), whose poses are kept.
   size_t frames_mapped = 0;
+  /// Poses corrected (PassSettings::reintegrate): scans not integrated again, poses kept.
+  size_t frames_not_reintegrated = 0;
   size_t frames_without_pose = 0;
   size_t frames_outside_range = 0;
   size_t points = 0;  ///< rays integrated

@@ -32,6 +32,8 @@ struct RelocalizationReport {
   double earlier_moved_max_m = 0.0;  ///< how far the links moved the map's earlier keyframes
   double earlier_moved_max_deg = 0.0;
   EarlierSessionsOutcome earlier;
+  /// Where the earlier sessions were mapped again: what was integrated again and kept.
+  std::optional<ReintegrationCounts> reintegration;
 };
 
 /// The recording could not be placed in the map: nothing was written into it.

@@ -14,6 +14,7 @@
 #include "featsense/config/config.hpp"
 #include "featsense/mapping/map_pass.hpp"
 #include "featsense/mapping/map_sessions.hpp"
+#include "featsense/mapping/reintegration_plan.hpp"
 #include "featsense/mapping/run_events.hpp"
 #include "featsense/mapping/saved_map.hpp"
 #include "featsense/slam/loops/map_keyframe.hpp"
@@ -51,9 +52,38 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
 /// Maps each session again from its input with its poses (interpolated within each sweep),
 /// in order, into `into` (replaced). Throws Interrupted, slam::InputError or
 /// std::runtime_error.
+/// With `only`, session s integrates only the scans of (*only)[s], each with the local map
+/// the plan gives it (reintegration_plan.hpp).
 void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
                     const PassSettings& replay, const config::Config& config,
-                    const std::string& sensor_name, const RunEvents& events);
+                    const std::string& sensor_name, const RunEvents& events,
+                    const std::vector<ScanReintegration>* only = nullptr);
+
+/// What remap_sessions_where_moved did.
+struct ReintegrationCounts {
+  /// Every scan was integrated again (the map before could not be used); `why` says why.
+  bool whole = false;
+  std::string why;
+  size_t scans = 0;
+  size_t scans_moved = 0;
+  size_t scans_reintegrated = 0;
+  size_t chunks_before = 0;   ///< chunks of the map before
+  size_t chunks_changed = 0;  ///< chunks a moved scan reached, made again
+  size_t chunks_kept = 0;     ///< chunks of the map before copied byte for byte
+  double plan_s = 0.0;
+  double reintegrate_s = 0.0;
+  double assemble_s = 0.0;
+};
+
+/// remap_sessions, integrating again only what moved (the rule: reintegration_plan.hpp): the
+/// first sessions of `sessions` are those of `before` (the map file they were integrated into,
+/// in the same frame), in order; any after them are new to it. `into` gets the changed chunks
+/// as a full re-map makes them and every other chunk of `before` byte for byte; its sessions,
+/// poses and keyframes are a full re-map's. Throws as remap_sessions.
+ReintegrationCounts remap_sessions_where_moved(
+    const SavedMap& before, const std::vector<SessionRemap>& sessions,
+    const std::filesystem::path& into, const PassSettings& replay, const config::Config& config,
+    const std::string& sensor_name, const RunEvents& events);
 
 /// A keyframe by session and index, for reports of links between sessions.
 struct KeyframeId {
