@@ -1,4 +1,5 @@
-// featsense eval traj | mesh: figures of a trajectory or mesh against ground truth.
+// featsense eval traj | mesh | maps: figures of a trajectory or mesh against ground truth, and
+// two maps compared voxel by voxel.
 
 #include <spdlog/spdlog.h>
 
@@ -12,6 +13,8 @@
 #include "featsense/config/config_error.hpp"
 #include "featsense/mesh/region_comparison.hpp"
 #include "featsense/slam/trajectory/trajectory_io.hpp"
+#include "featsense/storage/hdf5_chunk_store.hpp"
+#include "featsense/storage/map_comparison.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/ply_mesh_io.hpp"
 #include "featsense/viewer_export/surface_file_regions.hpp"
@@ -41,6 +44,12 @@ struct EvalMeshOptions {
   double samples_per_m2 = mesh::CompareSettings{}.samples_per_m2;
   std::optional<std::string> json_path;
   std::optional<std::string> ply_path;
+};
+
+struct EvalMapsOptions {
+  std::string first;
+  std::string second;
+  std::optional<std::string> json_path;
 };
 
 void emit(const nlohmann::json& json, const std::optional<std::string>& path,
@@ -164,10 +173,35 @@ void run_mesh(const EvalMeshOptions& options) {
   emit(json, options.json_path, text);
 }
 
+void run_maps(const EvalMapsOptions& options) {
+  storage::Hdf5ChunkStore first(options.first);
+  storage::Hdf5ChunkStore second(options.second);
+  const storage::MapDifference d = storage::compare_maps(first, second);
+  const nlohmann::json json = {{"identical", d.identical()},
+                               {"chunks_equal", d.chunks_equal},
+                               {"chunks_differing", d.chunks_differing},
+                               {"chunks_only_first", d.chunks_only_first},
+                               {"chunks_only_second", d.chunks_only_second},
+                               {"voxels_differing", d.voxels_differing},
+                               {"voxels_observed_in_one", d.voxels_observed_in_one},
+                               {"largest_value_difference_m", d.largest_value_difference_m},
+                               {"largest_weight_difference", d.largest_weight_difference}};
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "%s: %zu chunks equal, %zu differing (%zu voxels, %zu observed in one only; "
+                "values up to %.4f m, weights up to %.2f apart), %zu only in the first, %zu only "
+                "in the second\n",
+                d.identical() ? "identical" : "different", d.chunks_equal, d.chunks_differing,
+                d.voxels_differing, d.voxels_observed_in_one, d.largest_value_difference_m,
+                d.largest_weight_difference, d.chunks_only_first, d.chunks_only_second);
+  emit(json, options.json_path, text);
+}
+
 }  // namespace
 
 std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/) {
-  CLI::App* eval = app.add_subcommand("eval", "Compare a trajectory or a mesh with ground truth");
+  CLI::App* eval =
+      app.add_subcommand("eval", "Compare a trajectory or a mesh with ground truth, or two maps");
   eval->require_subcommand(1);
 
   auto traj_options = std::make_shared<EvalTrajOptions>();
@@ -224,8 +258,21 @@ std::vector<Command> register_eval(CLI::App& app, const CliContext& /*context*/)
   mesh_command->add_option("--ply-out", mesh_options->ply_path,
                            "Write the mesh with scalar_distance and scalar_signed_distance");
 
+  auto maps_options = std::make_shared<EvalMapsOptions>();
+  CLI::App* maps = eval->add_subcommand(
+      "maps", "Two maps (.h5) of one grid compared chunk by chunk and voxel by voxel");
+  maps->add_option("FIRST", maps_options->first, "A map file (map.h5)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  maps->add_option("SECOND", maps_options->second,
+                   "Another map file of the same voxel size and tau")
+      ->required()
+      ->check(CLI::ExistingFile);
+  maps->add_option("--json", maps_options->json_path, "Write the figures as JSON ('-' = stdout)");
+
   return {{traj, [traj_options] { run_traj(*traj_options); }},
-          {mesh_command, [mesh_options] { run_mesh(*mesh_options); }}};
+          {mesh_command, [mesh_options] { run_mesh(*mesh_options); }},
+          {maps, [maps_options] { run_maps(*maps_options); }}};
 }
 
 }  // namespace featsense::app
