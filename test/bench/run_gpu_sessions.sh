@@ -7,7 +7,11 @@
 # lab continued into that map (must be refused, the map byte-identical). `merge`: the drive
 # mapped alone in its own frame, then merged into the loop's map, and the same figures.
 # BACKEND=cpu maps with the CPU backend (the same map); EXTRA adds settings. Results go to $OUT.
-# Usage: bash test/bench/run_gpu_sessions.sh loop|continue|merge
+# `full` and `moved` (after `loop`): the drive continued into the loop's map with the earlier
+# session mapped again, every scan (map.keep_unmoved=false, no mesh) or only where scans moved
+# (the default, with the run's mesh and evaluation); `moved` then compares the two maps voxel by
+# voxel (`featsense eval maps`).
+# Usage: bash test/bench/run_gpu_sessions.sh loop|continue|merge|full|moved
 set -uo pipefail
 tar xJf .device/bundle.tar.xz -C /tmp
 export LD_LIBRARY_PATH=/tmp/bundle/lib
@@ -69,6 +73,35 @@ print('sessions', [(s['id'], s['scans'], s['keyframes']) for s in r['sessions']]
   "$f" -q map L --continue MB/map.h5 -o ML --backend "$backend" $extra 2> "$out/lab_refused.txt"
   echo "lab into town: exit $?, $(tail -c 600 "$out/lab_refused.txt")"
   sha256sum -c "$out/before_lab.sha256"
+elif [ "$what" = full ] || [ "$what" = moved ]; then
+  reintegration() {  # report
+    python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1])); l = r['relocalization']; e = l['earlier_sessions']
+print('earlier keyframes moved up to %.1f mm, %.3f deg' % (1000 * e['moved_max_m'], e['moved_max_deg']))
+print('reintegration', json.dumps(e.get('reintegration')))
+m = r.get('eval', {}).get('mesh', {}); a = m.get('accuracy', {})
+if a: print('mesh vs truth as mapped: mean %.4f median %.4f p95 %.4f m (p95/mean %.2f)' % (
+      a['mean_abs'], a['median'], a['p95'], a['p95'] / a['mean_abs']), 'completeness', json.dumps(m.get('completeness')))" "$1"
+  }
+  if [ "$what" = full ]; then
+    rm -rf MBF
+    timed "continue, every scan again ($backend)" "$f" -q map B --continue MA/map.h5 -o MBF \
+      --backend "$backend" $extra --no-mesh --set map.keep_unmoved=false
+    cp MBF/report.json "$out/full_report.json"
+    reintegration MBF/report.json
+  else
+    rm -rf MBS
+    timed "continue, only where moved ($backend)" "$f" -q map B --continue MA/map.h5 -o MBS \
+      --backend "$backend" $extra
+    cp MBS/report.json "$out/moved_report.json"
+    reintegration MBS/report.json
+    python3 "$root/test/bench/pose_error.py" MBS/trajectory.tum B/gt_trajectory.tum "drive placed, vs truth"
+    timed "eval maps" "$f" eval maps MBF/map.h5 MBS/map.h5 --json "$out/maps_difference.json"
+    cat "$out/maps_difference.json"; echo
+    timed "eval maps, loop before vs moved" "$f" eval maps MA/map.h5 MBS/map.h5 --json "$out/maps_before_moved.json"
+    cat "$out/maps_before_moved.json"; echo
+  fi
 else
   rm -rf B2 MB2 MM.*
   mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done
