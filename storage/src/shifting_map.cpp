@@ -162,29 +162,29 @@ ShiftingMap::ShiftingMap(tsdf::Integrator& map, ChunkStore& store, double shift_
   }
 }
 
-tsdf::Vec3 ShiftingMap::centre_m() const {
-  const tsdf::LocalMapGeometry& g = map_.geometry();
-  const tsdf::Vec3 lo = g.min_corner();
-  const tsdf::Vec3 hi = g.max_corner();
-  return 0.5f * (lo + hi);
+namespace {
+
+tsdf::Vec3 centre_of(const tsdf::LocalMapGeometry& geometry) {
+  return 0.5f * (geometry.min_corner() + geometry.max_corner());
 }
+
+}  // namespace
+
+tsdf::Vec3 ShiftingMap::centre_m() const { return centre_of(map_.geometry()); }
 
 tsdf::Index3 followed_origin(const tsdf::LocalMapGeometry& geometry, tsdf::Vec3 sensor_m,
                              double shift_threshold_m) {
-  const tsdf::Vec3 centre = 0.5f * (geometry.min_corner() + geometry.max_corner());
-  if (tsdf::norm(sensor_m - centre) <= shift_threshold_m) return geometry.origin;
+  if (tsdf::norm(sensor_m - centre_of(geometry)) <= shift_threshold_m) return geometry.origin;
   return tsdf::centred_origin(geometry, sensor_m);
 }
 
 bool ShiftingMap::follow(tsdf::Vec3 sensor_m) {
-  const Index3 origin = followed_origin(map_.geometry(), sensor_m, shift_threshold_m_);
-  const Index3 now = map_.geometry().origin;
-  if (origin.x == now.x && origin.y == now.y && origin.z == now.z) return false;
-  move_to(origin);
-  return true;
+  return move_to(followed_origin(map_.geometry(), sensor_m, shift_threshold_m_));
 }
 
-void ShiftingMap::move_to(Index3 origin) {
+bool ShiftingMap::move_to(Index3 origin) {
+  const Index3 now = map_.geometry().origin;
+  if (origin.x == now.x && origin.y == now.y && origin.z == now.z) return false;
   const tsdf::ShiftStats shift = tsdf::shift_local_map(
       map_, origin,
       [this](const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
@@ -194,10 +194,11 @@ void ShiftingMap::move_to(Index3 origin) {
         spill(bricks, [&](size_t k) { return voxels.data() + k * kBrickVoxels; });
       },
       shift_buffers_);
-  if (shift.bricks_left == 0) return;
+  if (shift.bricks_left == 0) return true;
   ++stats_.shifts;
   stats_.bricks_spilled += shift.bricks_left;
   stats_.bricks_loaded += shift.bricks_entered;
+  return true;
 }
 
 void ShiftingMap::sync() {

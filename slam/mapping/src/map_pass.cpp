@@ -203,9 +203,7 @@ void MapPass::integrate(LocatedScan scan) {
   storage::ShiftingMap& map = *store_->map;
   Clock::time_point start = Clock::now();
   if (settings_.reintegrate) {
-    const tsdf::Index3 origin = settings_.reintegrate->origins.at(scan.placement.stamp_ns);
-    const tsdf::Index3 now = map.integrator().geometry().origin;
-    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) map.move_to(origin);
+    map.move_to(settings_.reintegrate->origins.at(scan.placement.stamp_ns));
   } else {
     map.follow(local_map_anchor(scan.placement.T_map_sensor));
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "featsense/config/sensor_model.hpp"
 #include "featsense/storage/shifting_map.hpp"
 #include "featsense/tsdf/tsdf_settings.hpp"
 
@@ -56,8 +57,9 @@ MetricBox box_of(const tsdf::LocalMapGeometry& geometry) {
 /// Where a scan at `position` may have written in the map before, wherever its local map had
 /// followed the sensor to: the map's centre lies within the shift threshold of the sensor, or
 /// in the sensor's brick.
-MetricBox reach_around(const Eigen::Vector3d& position, const LocalMapReach& reach) {
-  const double slack = reach.shift_threshold_m + tsdf::kBrickSize * reach.voxel_size_m;
+MetricBox reach_around(const Eigen::Vector3d& position, const LocalMapReach& reach,
+                       double voxel_size_m) {
+  const double slack = reach.shift_threshold_m + tsdf::kBrickSize * voxel_size_m;
   const Eigen::Vector3d half(0.5 * reach.size_m[0] + slack, 0.5 * reach.size_m[1] + slack,
                              0.5 * reach.size_m[2] + slack);
   return {position - half, position + half};
@@ -84,21 +86,15 @@ bool same_scans(const slam::Trajectory& a, const slam::Trajectory& b) {
   return a.size() == b.size() && a.stamps_ns == b.stamps_ns;
 }
 
-tsdf::TsdfSettings local_map_settings(const config::MapConfig& map) {
-  tsdf::TsdfSettings settings;
-  settings.voxel_size_m = static_cast<float>(map.voxel_size_m);
-  settings.map_size_m = {static_cast<float>(map.size_m[0]), static_cast<float>(map.size_m[1]),
-                         static_cast<float>(map.size_m[2])};
-  return settings;
-}
-
-/// Each scan's local map as a pass that integrates them all in order places it.
+/// Each scan's local map as a pass that integrates them all in order places it (its size and
+/// voxel as a pass converts them; the sensor does not change them).
 std::vector<tsdf::LocalMapGeometry> local_maps(const slam::Trajectory& poses,
                                                const config::MapConfig& map) {
   std::vector<tsdf::LocalMapGeometry> out;
   if (poses.empty()) return out;
   tsdf::LocalMapGeometry geometry =
-      tsdf::centred_geometry(local_map_settings(map), local_map_anchor(poses.poses.front()));
+      tsdf::centred_geometry(tsdf::TsdfSettings::from_config(map, config::SensorModel{}),
+                             local_map_anchor(poses.poses.front()));
   for (const Eigen::Isometry3d& pose : poses.poses) {
     geometry.origin =
         storage::followed_origin(geometry, local_map_anchor(pose), map.shift_threshold_m);
@@ -116,7 +112,6 @@ tsdf::Vec3 local_map_anchor(const Eigen::Isometry3d& T_map_sensor) {
 
 LocalMapReach reach_before(const config::MapConfig& after, const config::MapConfig& before) {
   LocalMapReach reach;
-  reach.voxel_size_m = after.voxel_size_m;
   for (int axis = 0; axis < 3; ++axis)
     reach.size_m[axis] = std::max(after.size_m[axis], before.size_m[axis]);
   reach.shift_threshold_m = std::max(after.shift_threshold_m, before.shift_threshold_m);
@@ -126,6 +121,7 @@ LocalMapReach reach_before(const config::MapConfig& after, const config::MapConf
 ReintegrationPlan plan_reintegration(const std::vector<SessionPoses>& sessions,
                                      const config::MapConfig& after, const LocalMapReach& before) {
   ReintegrationPlan plan;
+  const auto mark_changed = [&](const storage::ChunkKey& key) { plan.changed.insert(key); };
   const double voxel = after.voxel_size_m;
   const double quarter_voxel = 0.25 * voxel;
   std::vector<std::vector<tsdf::LocalMapGeometry>> maps_after;
@@ -138,16 +134,14 @@ ReintegrationPlan plan_reintegration(const std::vector<SessionPoses>& sessions,
     if (!same_scans(old, now)) {
       // Not known scan by scan: whatever it wrote before and writes now changes.
       for (const Eigen::Isometry3d& pose : old.poses)
-        for_each_chunk(chunks_of(reach_around(pose.translation(), before), voxel),
-                       [&](const storage::ChunkKey& key) { plan.changed.insert(key); });
-      for (const tsdf::LocalMapGeometry& map : maps)
-        for_each_chunk(chunks_of(map),
-                       [&](const storage::ChunkKey& key) { plan.changed.insert(key); });
+        for_each_chunk(chunks_of(reach_around(pose.translation(), before, voxel), voxel),
+                       mark_changed);
+      for (const tsdf::LocalMapGeometry& map : maps) for_each_chunk(chunks_of(map), mark_changed);
       plan.scans_moved += now.size();
       continue;
     }
     for (size_t k = 0; k < now.size(); ++k) {
-      const MetricBox reach_old = reach_around(old.poses[k].translation(), before);
+      const MetricBox reach_old = reach_around(old.poses[k].translation(), before, voxel);
       const MetricBox reach = joined(reach_old, box_of(maps[k]));
       bool moved = false;
       const size_t first = k == 0 ? 0 : k - 1;
@@ -156,10 +150,8 @@ ReintegrationPlan plan_reintegration(const std::vector<SessionPoses>& sessions,
         moved = largest_move(now.poses[j] * old.poses[j].inverse(), reach) > quarter_voxel;
       if (!moved) continue;
       ++plan.scans_moved;
-      for_each_chunk(chunks_of(reach_old, voxel),
-                     [&](const storage::ChunkKey& key) { plan.changed.insert(key); });
-      for_each_chunk(chunks_of(maps[k]),
-                     [&](const storage::ChunkKey& key) { plan.changed.insert(key); });
+      for_each_chunk(chunks_of(reach_old, voxel), mark_changed);
+      for_each_chunk(chunks_of(maps[k]), mark_changed);
     }
   }
   for (size_t s = 0; s < sessions.size(); ++s) {

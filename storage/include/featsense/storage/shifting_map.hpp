@@ -37,8 +37,9 @@ class ShiftingMap {
   /// Moves the local map onto the sensor when the sensor is more than the shift threshold
   /// from the map's centre. Returns true when it moved.
   bool follow(tsdf::Vec3 sensor_m);
-  /// Moves the local map so that its lowest corner is `origin` (whole bricks).
-  void move_to(tsdf::Index3 origin);
+  /// Moves the local map so that its lowest corner is `origin` (whole bricks). Returns true
+  /// when it moved (false: it was there already).
+  bool move_to(tsdf::Index3 origin);
   /// Writes the local map's observed chunks into the store (unchanged ones are skipped) and
   /// flushes the store: afterwards the store alone holds the whole map, durably.
   void sync();

@@ -61,10 +61,9 @@ struct ReintegrationPlan {
   size_t scans_reintegrated = 0;
 };
 
-/// Local map settings that bound where the map before was written: its extent, shift
-/// threshold and voxel size (the largest of this run's and the map's own).
+/// Local map settings that bound where the map before was written: its extent and shift
+/// threshold (the largest of this run's and the map's own; a map keeps its voxel size).
 struct LocalMapReach {
-  double voxel_size_m = 0.064;
   std::array<double, 3> size_m = {40.0, 40.0, 15.0};
   double shift_threshold_m = 3.0;
 };
