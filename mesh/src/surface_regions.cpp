@@ -51,15 +51,9 @@ MeshRegions::MeshRegions(const TriangleMesh& mesh, double cell_m) : mesh_(mesh),
       fill.assign(first_.begin(), first_.end() - 1);
     }
     for (size_t i = 0; i < items; ++i) {
-      Eigen::AlignedBox3d box;
-      if (i >= triangles) {
-        box = Eigen::AlignedBox3d(mesh.vertices[vertex_of(i)].cast<double>());
-      } else {
-        box.setEmpty();
-        for (int k = 0; k < 3; ++k) {
-          box.extend(mesh.vertices[static_cast<size_t>(mesh.triangles[i][k])].cast<double>());
-        }
-      }
+      const Eigen::AlignedBox3d box =
+          i >= triangles ? Eigen::AlignedBox3d(mesh.vertices[vertex_of(i)].cast<double>())
+                         : triangle_bounds(mesh, i);
       const auto [a, b] = cell_range(box.min(), box.max());
       for (int y = a.y(); y <= b.y(); ++y) {
         for (int x = a.x(); x <= b.x(); ++x) {
@@ -111,12 +105,7 @@ SurfacePiece MeshRegions::read(const Eigen::AlignedBox3d& box) const {
       if (box.contains(mesh_.vertices[v].cast<double>())) loose.push_back(v);
       continue;
     }
-    Eigen::AlignedBox3d extent;
-    extent.setEmpty();
-    for (int k = 0; k < 3; ++k) {
-      extent.extend(mesh_.vertices[static_cast<size_t>(mesh_.triangles[i][k])].cast<double>());
-    }
-    if (extent.intersects(box)) triangles.push_back(i);
+    if (triangle_bounds(mesh_, i).intersects(box)) triangles.push_back(i);
   }
   SurfacePiece piece;
   piece.mesh = triangle_subset(mesh_, triangles, &piece.source_index);

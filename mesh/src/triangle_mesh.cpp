@@ -161,4 +161,12 @@ TriangleMesh triangle_subset(const TriangleMesh& mesh, const std::vector<uint32_
   return out;
 }
 
+Eigen::AlignedBox3d triangle_bounds(const TriangleMesh& mesh, std::size_t t) {
+  Eigen::AlignedBox3d box;
+  box.setEmpty();
+  for (int k = 0; k < 3; ++k)
+    box.extend(mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][k])].cast<double>());
+  return box;
+}
+
 }  // namespace featsense::mesh

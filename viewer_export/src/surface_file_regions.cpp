@@ -92,12 +92,7 @@ mesh::TriangleMesh triangles_meeting(const mesh::TriangleMesh& mesh,
                                      const Eigen::AlignedBox3d& box) {
   std::vector<uint32_t> meeting;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    Eigen::AlignedBox3d extent;
-    extent.setEmpty();
-    for (int k = 0; k < 3; ++k) {
-      extent.extend(mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][k])].cast<double>());
-    }
-    if (extent.intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
+    if (mesh::triangle_bounds(mesh, t).intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
   }
   return mesh::triangle_subset(mesh, meeting);
 }

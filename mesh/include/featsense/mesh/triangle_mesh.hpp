@@ -5,6 +5,7 @@
 /// so that libraries that only pass meshes around need not link the meshing library.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstddef>
 #include <cstdint>
@@ -90,5 +91,8 @@ double surface_area_m2(const TriangleMesh& mesh);
 /// dropped. Where given, `source_vertex` receives each kept vertex's index in `mesh`.
 TriangleMesh triangle_subset(const TriangleMesh& mesh, const std::vector<uint32_t>& which,
                              std::vector<uint64_t>* source_vertex = nullptr);
+
+/// The axis-aligned box of triangle `t`'s three vertices, in doubles.
+Eigen::AlignedBox3d triangle_bounds(const TriangleMesh& mesh, std::size_t t);
 
 }  // namespace featsense::mesh
