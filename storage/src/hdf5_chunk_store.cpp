@@ -34,8 +34,9 @@ std::string format_length(double metres) {
   return out.str();
 }
 
+/// `what`: the action refused, with the map it names ("cannot continue the map").
 void check_compatible(const MapMetadata& file, const MapMetadata& wanted,
-                      const std::filesystem::path& path) {
+                      const std::filesystem::path& path, const char* what) {
   std::string problems;
   if (!same_length(file.voxel_size_m, wanted.voxel_size_m))
     problems += " voxel size: map " + format_length(file.voxel_size_m) + ", this run " +
@@ -49,7 +50,7 @@ void check_compatible(const MapMetadata& file, const MapMetadata& wanted,
                 std::to_string(wanted.value_scale) + "/" + std::to_string(wanted.weight_scale) +
                 ";";
   if (!problems.empty())
-    throw std::runtime_error("cannot continue the map " + path.string() +
+    throw std::runtime_error(std::string(what) + " " + path.string() +
                              ", its settings differ:" + problems);
 }
 
@@ -104,7 +105,7 @@ void Hdf5ChunkStore::open_existing(OpenMode mode, const MapMetadata* expected) {
   writable_ = mode == OpenMode::kAppend;
   file_ = std::make_unique<detail::Hdf5MapReader>(path_);
   metadata_ = file_->metadata();
-  if (expected != nullptr) check_compatible(metadata_, *expected, path_);
+  if (expected != nullptr) check_compatible(metadata_, *expected, path_, "cannot continue the map");
   for (const auto& key : file_->keys()) {
     stored_[key] = Location{};
     present_.insert(key);
@@ -362,21 +363,8 @@ void Hdf5ChunkStore::checkpoint() {
   const auto tmp = with_suffix(path_, ".tmp");
   try {
     detail::Hdf5MapWriter writer(tmp, metadata_, settings_.deflate_level);
-    for (const auto& key : present_) {
-      const Location& where = stored_.at(key);
-      if (where.in_journal)
-        writer.write_chunk(key, load(key, where));
-      else
-        writer.copy_chunk(*file_, key);
-    }
-    writer.write_trajectory(trajectory_);
-    for (const auto& [key, where] : keyframes_) {
-      if (where.in_journal)
-        writer.write_keyframe(load_keyframe(key, where));
-      else
-        writer.copy_keyframe(*file_, key);
-    }
-    writer.write_sessions(sessions_);
+    for (const auto& key : present_) write_durable_chunk(writer, key);
+    write_durable_records(writer);
     writer.close();
   } catch (...) {
     std::error_code ignored;
@@ -391,6 +379,56 @@ void Hdf5ChunkStore::checkpoint() {
   for (auto& [key, where] : stored_) where = Location{};
   for (auto& [key, where] : keyframes_) where = Location{};
   metadata_.format_version = kFormatVersion;
+}
+
+void Hdf5ChunkStore::write_durable_chunk(detail::Hdf5MapWriter& writer, const ChunkKey& key) const {
+  const Location& where = stored_.at(key);
+  if (where.in_journal)
+    writer.write_chunk(key, load(key, where));
+  else
+    writer.copy_chunk(*file_, key);
+}
+
+void Hdf5ChunkStore::write_durable_records(detail::Hdf5MapWriter& writer) const {
+  writer.write_trajectory(trajectory_);
+  for (const auto& [key, where] : keyframes_) {
+    if (where.in_journal)
+      writer.write_keyframe(load_keyframe(key, where));
+    else
+      writer.copy_keyframe(*file_, key);
+  }
+  writer.write_sessions(sessions_);
+}
+
+void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                 const std::function<bool(const ChunkKey&)>& from_newer,
+                 const Hdf5ChunkStore& older) {
+  for (const Hdf5ChunkStore* map : {&newer, &older}) {
+    if (map->closed_) throw std::logic_error("splicing a closed map: " + map->path_.string());
+    if (map->has_unflushed_writes())
+      throw std::logic_error("splicing a map with unflushed writes: " + map->path_.string());
+    if (std::filesystem::exists(into) && std::filesystem::equivalent(into, map->path_))
+      throw std::invalid_argument("a spliced map cannot replace one of its sources: " +
+                                  into.string());
+  }
+  check_compatible(older.metadata_, newer.metadata_, older.path_, "cannot splice the map");
+  const auto tmp = with_suffix(into, ".tmp");
+  try {
+    detail::Hdf5MapWriter writer(tmp, newer.metadata_, newer.settings_.deflate_level);
+    for (const ChunkKey& key : newer.present_)
+      if (from_newer(key)) newer.write_durable_chunk(writer, key);
+    for (const ChunkKey& key : older.present_)
+      if (!from_newer(key)) older.write_durable_chunk(writer, key);
+    newer.write_durable_records(writer);
+    writer.close();
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
+  // A journal left by an earlier map at `into` would be replayed over this one.
+  std::filesystem::remove(with_suffix(into, ".journal"));
+  detail::replace_file(tmp, into);
 }
 
 void Hdf5ChunkStore::close() {

@@ -97,11 +97,45 @@ if a: print('mesh vs truth as mapped: mean %.4f median %.4f p95 %.4f m (p95/mean
     cp MBS/report.json "$out/moved_report.json"
     reintegration MBS/report.json
     python3 "$root/test/bench/pose_error.py" MBS/trajectory.tum B/gt_trajectory.tum "drive placed, vs truth"
-    timed "eval maps" "$f" eval maps MBF/map.h5 MBS/map.h5 --json "$out/maps_difference.json"
-    cat "$out/maps_difference.json"; echo
+    if [ -f MBF/map.h5 ]; then
+      timed "eval maps" "$f" eval maps MBF/map.h5 MBS/map.h5 --json "$out/maps_difference.json"
+      cat "$out/maps_difference.json"; echo
+    fi
     timed "eval maps, loop before vs moved" "$f" eval maps MA/map.h5 MBS/map.h5 --json "$out/maps_before_moved.json"
     cat "$out/maps_before_moved.json"; echo
   fi
+elif [ "$what" = drive ] || [ "$what" = merges ]; then
+  # `drive`: only the drive mapped alone, for `merges` in a later call of the same machine.
+  if [ "$what" = drive ] || [ ! -f MB2/map.h5 ]; then
+    rm -rf B2 MB2
+    mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done
+    timed "map the drive alone ($backend)" "$f" -q map B2 -o MB2 --backend "$backend" $extra --no-mesh
+    [ "$what" = drive ] && exit 0
+  fi
+  rm -rf MF* MS*
+  # Alternating, ROUNDS times (default 1; a round is about 5 min on 16 cores).
+  for round in $(seq "${ROUNDS:-1}"); do
+    timed "merge $round, every scan again ($backend)" "$f" -q merge MA/map.h5 MB2/map.h5 \
+      -o MF$round.h5 --backend "$backend" $extra --set map.keep_unmoved=false
+    timed "merge $round, only where moved ($backend)" "$f" -q merge MA/map.h5 MB2/map.h5 \
+      -o MS$round.h5 --backend "$backend" $extra
+  done
+  for h in MF*.h5 MS*.h5; do
+    m=${h%.h5}
+    cp $m.report.json "$out/${m}_report.json"
+    python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1]))
+print(sys.argv[2], 'reintegration', json.dumps(r.get('reintegration')))" $m.report.json $m
+  done
+  for s in 0 1; do
+    cmp MF1.session$s.tum MS1.session$s.tum && echo "session $s: the same poses in both merges"
+  done
+  python3 "$root/test/bench/pose_error.py" MS1.session1.tum B/gt_trajectory.tum "drive merged, vs truth"
+  timed "eval maps, full vs moved" "$f" eval maps MF1.h5 MS1.h5 --json "$out/merges_difference.json"
+  cat "$out/merges_difference.json"; echo
+  timed "eval maps, loop before vs moved" "$f" eval maps MA/map.h5 MS1.h5 --json "$out/merges_before_moved.json"
+  cat "$out/merges_before_moved.json"; echo
 else
   rm -rf B2 MB2 MM.*
   mkdir B2 && for x in B/*; do case $x in *gt_*) ;; *) ln -s "$w/$x" B2/ ;; esac; done

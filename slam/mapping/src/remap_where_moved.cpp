@@ -48,31 +48,17 @@ std::string why_whole(const SavedMap& before, const std::vector<SessionRemap>& s
 }
 
 /// The map after: `scratch`'s sessions, poses and keyframes, its chunks where they changed,
-/// every other chunk of `before` byte for byte.
+/// every other chunk of `before` as stored, still compressed.
 void assemble(const fs::path& before_path, const fs::path& scratch_path, const fs::path& into,
               const ChunkSet& changed, ReintegrationCounts& counts) {
-  storage::Hdf5ChunkStore scratch(scratch_path);
-  storage::Hdf5ChunkStore before(before_path);
-  storage::Hdf5ChunkStore after(into, storage::OpenMode::kCreateOverwrite, scratch.metadata());
-  for (const storage::ChunkKey& key : scratch.keys()) {
-    if (changed.count(key) == 0) continue;
-    if (std::optional<storage::Chunk> chunk = scratch.read(key)) {
-      after.write(key, *chunk);
-      ++counts.chunks_changed;
-    }
-  }
+  const storage::Hdf5ChunkStore scratch(scratch_path);
+  const storage::Hdf5ChunkStore before(before_path);
+  const auto is_changed = [&](const storage::ChunkKey& key) { return changed.count(key) > 0; };
+  for (const storage::ChunkKey& key : scratch.keys()) counts.chunks_changed += is_changed(key);
   const std::vector<storage::ChunkKey> before_keys = before.keys();
   counts.chunks_before = before_keys.size();
-  for (const storage::ChunkKey& key : before_keys) {
-    if (changed.count(key) > 0) continue;
-    if (std::optional<storage::Chunk> chunk = before.read(key)) {
-      after.write(key, *chunk);
-      ++counts.chunks_kept;
-    }
-  }
-  after.write_trajectory(scratch.read_trajectory());
-  copy_sessions(scratch, after);
-  after.close();
+  for (const storage::ChunkKey& key : before_keys) counts.chunks_kept += !is_changed(key);
+  storage::splice_maps(into, scratch, is_changed, before);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <list>
 #include <map>
 #include <memory>
@@ -24,6 +25,7 @@ namespace featsense::storage {
 namespace detail {
 class Journal;
 class Hdf5MapReader;
+class Hdf5MapWriter;
 }  // namespace detail
 
 enum class OpenMode {
@@ -44,6 +46,18 @@ struct StoreSettings {
   /// its mapping 6 % slower on 2 cores.
   int deflate_level = 1;
 };
+
+class Hdf5ChunkStore;
+
+/// Writes a new map file at `into`, replacing any map there and its journal: `newer`'s
+/// metadata, trajectory, sessions, keyframes and its chunks for which `from_newer` holds, and
+/// every other chunk of `older`. What a map keeps in its .h5 (a closed map: everything) is
+/// copied as stored, still compressed; what is still in its journal is encoded afresh. Both
+/// maps must have nothing unflushed (std::logic_error) and the same voxel size, tau and
+/// encoding (std::runtime_error naming both values); `into` must be neither of them.
+void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                 const std::function<bool(const ChunkKey&)>& from_newer,
+                 const Hdf5ChunkStore& older);
 
 class Hdf5ChunkStore final : public ChunkStore {
  public:
@@ -97,6 +111,10 @@ class Hdf5ChunkStore final : public ChunkStore {
   std::size_t journal_bytes() const;
 
  private:
+  friend void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                          const std::function<bool(const ChunkKey&)>& from_newer,
+                          const Hdf5ChunkStore& older);
+
   struct Location {
     bool in_journal = false;  ///< else in the .h5
     uint64_t offset = 0;      ///< of the record's payload in the journal, bytes
@@ -120,6 +138,11 @@ class Hdf5ChunkStore final : public ChunkStore {
   /// Appends the unflushed keyframes and, when changed, the sessions table to the journal.
   void journal_keyframes_and_sessions();
   bool has_unflushed_writes() const;
+  /// Puts a durable chunk into `writer`: copied as stored from the .h5, else decoded from the
+  /// journal and encoded again.
+  void write_durable_chunk(detail::Hdf5MapWriter& writer, const ChunkKey& key) const;
+  /// Puts the trajectory, the durable keyframes and the sessions into `writer`.
+  void write_durable_records(detail::Hdf5MapWriter& writer) const;
 
   std::filesystem::path path_;
   StoreSettings settings_;
