@@ -25,12 +25,13 @@ namespace {
 namespace fs = std::filesystem;
 using test::read_chunks;
 
-constexpr int kFrames = 24;
+constexpr int kFrames = 26;
 constexpr size_t kFirstMoved = 18;
 
 class RemapWhereMoved : public ::testing::Test {
  protected:
-  /// A corridor walk of 24 slow revolutions (34 m), written once for every test.
+  /// A corridor walk of 26 slow revolutions (33 m), written once for every test; 1.1 Hz so
+  /// that the stamps are not whole seconds, which a double holds exactly.
   static void SetUpTestSuite() {
     root_ = new fs::path(fs::temp_directory_path() /
                          ("featsense_remap_where_moved_" + std::to_string(::getpid())));
@@ -39,7 +40,7 @@ class RemapWhereMoved : public ::testing::Test {
     request.scene = "corridor";
     request.path = "walk";
     request.sensor = "os1-64";
-    request.rate_hz = 1.0;
+    request.rate_hz = 1.1;
     request.frames = kFrames;
     const slam::PreparedSimulation simulation(request);
     slam::SimulationWriter writer((*root_ / "corridor").string(),
@@ -94,9 +95,11 @@ slam::Trajectory end_moved(slam::Trajectory poses) {
 
 TEST_F(RemapWhereMoved, ChangedChunksAreAFullRemapsAndTheOthersTheMapBefore) {
   remap(session(truth()), dir_ / "before.h5");
-  const SessionRemap moved = session(end_moved(truth()));
-  remap(moved, dir_ / "full.h5");
   const SavedMap before = read_saved_map(dir_ / "before.h5");
+  // As `map --continue` and `merge` have them: the map's own poses (their stamps read back
+  // from seconds in a double, a few hundred nanoseconds from the scans'), moved.
+  const SessionRemap moved = session(end_moved(before.sessions[0].poses));
+  remap(moved, dir_ / "full.h5");
   const ReintegrationCounts counts = remap_sessions_where_moved(
       before, {moved}, dir_ / "where_moved.h5", pass_settings(config_), config_, "os1-64", {});
 
@@ -153,6 +156,7 @@ TEST_F(RemapWhereMoved, ChangedChunksAreAFullRemapsAndTheOthersTheMapBefore) {
   storage::Hdf5ChunkStore after_store(dir_ / "where_moved.h5");
   const auto full_poses = full_store.read_trajectory();
   const auto after_poses = after_store.read_trajectory();
+  EXPECT_EQ(full_poses.size(), static_cast<size_t>(kFrames));  // the first and last scan too
   ASSERT_EQ(after_poses.size(), full_poses.size());
   for (size_t i = 0; i < full_poses.size(); ++i) {
     EXPECT_EQ(after_poses[i].t_s, full_poses[i].t_s);
@@ -239,6 +243,27 @@ TEST(ReintegrationPlan, ASessionNewToTheMapMovedEverywhere) {
   EXPECT_EQ(plan.scans_moved, 10u);
   EXPECT_TRUE(plan.sessions[0].origins.empty());  // far from the new one
   EXPECT_EQ(plan.sessions[1].origins.size(), 10u);
+}
+
+TEST(ReintegrationPlan, ScansAreFoundByStampsReadBackFromTheMap) {
+  // The map keeps stamps as seconds in a double: they come back up to ~300 ns off.
+  config::MapConfig map;
+  const slam::Trajectory path = straight_path(10, 1.0);
+  slam::Trajectory read_back = path;
+  for (size_t k = 0; k < read_back.size(); ++k) read_back.stamps_ns[k] += k % 2 ? 303 : -303;
+  const ReintegrationPlan same =
+      plan_reintegration({{read_back, path}}, map, reach_before(map, map));
+  EXPECT_EQ(same.scans_moved, 0u);  // the same scans, none moved
+  const ReintegrationPlan moved =
+      plan_reintegration({{path, shifted(read_back, 0.05)}}, map, reach_before(map, map));
+  ASSERT_EQ(moved.scans_reintegrated, 10u);
+  const ScanReintegration& scans = moved.sessions[0];
+  for (size_t k = 0; k < path.size(); ++k) {
+    ASSERT_TRUE(scans.origin_at(path.stamps_ns[k])) << k;
+    EXPECT_TRUE(scans.origin_at(path.stamps_ns[k] + 600));
+    EXPECT_FALSE(scans.origin_at(path.stamps_ns[k] + 5'000));
+    EXPECT_FALSE(scans.origin_at(path.stamps_ns[k] + 500'000'000));
+  }
 }
 
 }  // namespace

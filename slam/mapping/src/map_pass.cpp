@@ -157,9 +157,9 @@ void MapPass::count_dropped(uint64_t sequence, ScanDrop why) {
 
 std::optional<LocatedScan> MapPass::make_rays(PlacedScan placed, bool skip_integration) {
   const Clock::time_point start = Clock::now();
-  const bool integrates = settings_.integrate && !skip_integration &&
-                          (!settings_.reintegrate ||
-                           settings_.reintegrate->origins.count(placed.placement.stamp_ns) > 0);
+  const bool integrates =
+      settings_.integrate && !skip_integration &&
+      (!settings_.reintegrate || settings_.reintegrate->origin_at(placed.placement.stamp_ns));
   if (const std::optional<double> ms =
           latency_.since_ready(placed.placement.sequence, !integrates)) {
     result_.timings.latency_final_pose_ms.push_back(*ms);
@@ -203,7 +203,7 @@ void MapPass::integrate(LocatedScan scan) {
   storage::ShiftingMap& map = *store_->map;
   Clock::time_point start = Clock::now();
   if (settings_.reintegrate) {
-    map.move_to(settings_.reintegrate->origins.at(scan.placement.stamp_ns));
+    map.move_to(*settings_.reintegrate->origin_at(scan.placement.stamp_ns));
   } else {
     map.follow(local_map_anchor(scan.placement.T_map_sensor));
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "featsense/config/sensor_model.hpp"
 #include "featsense/storage/shifting_map.hpp"
@@ -82,8 +83,13 @@ double largest_move(const Eigen::Isometry3d& change, const MetricBox& box) {
   return largest;
 }
 
+/// The same scans, by their stamps: a map's stored stamps come back within
+/// storage::kStoredStampToleranceNs of the recording's.
 bool same_scans(const slam::Trajectory& a, const slam::Trajectory& b) {
-  return a.size() == b.size() && a.stamps_ns == b.stamps_ns;
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k)
+    if (std::abs(a.stamps_ns[k] - b.stamps_ns[k]) > storage::kStoredStampToleranceNs) return false;
+  return true;
 }
 
 /// Each scan's local map as a pass that integrates them all in order places it (its size and
@@ -104,6 +110,14 @@ std::vector<tsdf::LocalMapGeometry> local_maps(const slam::Trajectory& poses,
 }
 
 }  // namespace
+
+std::optional<tsdf::Index3> ScanReintegration::origin_at(int64_t stamp_ns) const {
+  // The planned stamps are one scan period apart: at most one lies within the tolerance.
+  const auto next = origins.lower_bound(stamp_ns - storage::kStoredStampToleranceNs);
+  if (next == origins.end() || next->first > stamp_ns + storage::kStoredStampToleranceNs)
+    return std::nullopt;
+  return next->second;
+}
 
 tsdf::Vec3 local_map_anchor(const Eigen::Isometry3d& T_map_sensor) {
   const Eigen::Vector3d t = T_map_sensor.translation();

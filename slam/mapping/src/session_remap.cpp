@@ -5,6 +5,7 @@
 #include "featsense/mapping/map_pipeline.hpp"
 #include "featsense/mapping/recording.hpp"
 #include "featsense/slam/trajectory/given_pose_locator.hpp"
+#include "featsense/storage/chunk_store.hpp"
 
 namespace featsense::mapping {
 namespace {
@@ -78,8 +79,12 @@ void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& i
         slam::make_given_pose_locator(session.poses, config.odometry.deskew);
     PipelineSettings pipeline;
     if (session.poses.size() > 0) {
-      pipeline.range.first_stamp_ns = session.poses.stamps_ns.front();
-      pipeline.range.last_stamp_ns = session.poses.stamps_ns.back();
+      // The poses' stamps come from the map (storage::TrajectoryPose): the first and the last
+      // scan may lie a few hundred nanoseconds outside them.
+      pipeline.range.first_stamp_ns =
+          session.poses.stamps_ns.front() - storage::kStoredStampToleranceNs;
+      pipeline.range.last_stamp_ns =
+          session.poses.stamps_ns.back() + storage::kStoredStampToleranceNs;
     }
     const PassResult pass = run_pass(
         *source, *locator, settings, config,

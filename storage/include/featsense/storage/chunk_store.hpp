@@ -30,11 +30,19 @@ struct MapMetadata {
 
 /// One pose of the trajectory: time (seconds) and T_map_sensor as translation (metres) and a
 /// unit quaternion.
+///
+/// Seconds since 1970 in a double keep about 0.24 us: a stamp read back (rounded to whole
+/// nanoseconds) lies up to about 300 ns from the one written (twice that after 2106). Code
+/// that matches stored stamps to a recording's scans does so within kStoredStampToleranceNs.
 struct TrajectoryPose {
   double t_s = 0.0;
   double x = 0.0, y = 0.0, z = 0.0;
   double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;
 };
+
+/// How far a stamp read back from TrajectoryPose::t_s may lie from the scan's own stamp: well
+/// above the rounding above, far below the time between two scans of any sensor.
+constexpr int64_t kStoredStampToleranceNs = 1000;
 
 class ChunkStore {
  public:

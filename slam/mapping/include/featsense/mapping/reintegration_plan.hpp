@@ -25,14 +25,16 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <optional>
 #include <string>
-#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
 #include "featsense/config/config.hpp"
 #include "featsense/slam/trajectory/trajectory.hpp"
 #include "featsense/storage/chunk.hpp"
+#include "featsense/storage/chunk_store.hpp"
 #include "featsense/tsdf/vec3.hpp"
 
 namespace featsense::mapping {
@@ -48,7 +50,13 @@ struct SessionPoses {
 /// voxel index) as a full re-map would have it when it integrates that scan. A scan not in it
 /// keeps its pose only.
 struct ScanReintegration {
-  std::unordered_map<int64_t, tsdf::Index3> origins;
+  /// By the stamps of the poses planned from, which the map stores as seconds in a double.
+  std::map<int64_t, tsdf::Index3> origins;
+
+  /// The local map for the scan stamped `stamp_ns` (the recording's own stamp, which the
+  /// planned one matches within storage::kStoredStampToleranceNs); nothing where that scan is
+  /// not to be integrated again.
+  std::optional<tsdf::Index3> origin_at(int64_t stamp_ns) const;
 };
 
 using ChunkSet = std::unordered_set<storage::ChunkKey, storage::ChunkKeyHash>;
