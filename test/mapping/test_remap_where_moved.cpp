@@ -115,6 +115,7 @@ TEST_F(RemapWhereMoved, ChangedChunksAreAFullRemapsAndTheOthersTheMapBefore) {
   const ReintegrationPlan plan =
       plan_reintegration({{before.sessions[0].poses, moved.poses}}, config_.map,
                          reach_before(config_.map, config_.map));
+  EXPECT_EQ(counts.scans_reintegrated, plan.scans_reintegrated);  // every planned scan came
   const auto old_chunks = read_chunks(dir_ / "before.h5");
   const auto full = read_chunks(dir_ / "full.h5");
   const auto after = read_chunks(dir_ / "where_moved.h5");

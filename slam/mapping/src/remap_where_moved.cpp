@@ -75,10 +75,10 @@ ReintegrationCounts remap_sessions_where_moved(const SavedMap& before,
   if (!counts.why.empty()) {
     counts.whole = true;
     const Clock::time_point start = Clock::now();
-    remap_sessions(sessions, into, replay, config, sensor_name, events);
+    counts.scans_reintegrated = remap_sessions(sessions, into, replay, config, sensor_name, events);
     counts.reintegrate_s = seconds_since(start);
     for (const SessionRemap& s : sessions) counts.scans += s.poses.size();
-    counts.scans_moved = counts.scans_reintegrated = counts.scans;
+    counts.scans_moved = counts.scans;
     return counts;
   }
 
@@ -93,7 +93,6 @@ ReintegrationCounts remap_sessions_where_moved(const SavedMap& before,
       plan_reintegration(poses, config.map, reach_before(config.map, *before_map));
   counts.scans = plan.scans;
   counts.scans_moved = plan.scans_moved;
-  counts.scans_reintegrated = plan.scans_reintegrated;
   counts.plan_s = seconds_since(start);
   events.info(
       std::to_string(plan.scans_moved) + " of " + std::to_string(plan.scans) +
@@ -110,8 +109,16 @@ ReintegrationCounts remap_sessions_where_moved(const SavedMap& before,
   };
   remove_scratch();
   try {
-    remap_sessions(sessions, scratch, replay, config, sensor_name, events, &plan.sessions);
+    counts.scans_reintegrated =
+        remap_sessions(sessions, scratch, replay, config, sensor_name, events, &plan.sessions);
     counts.reintegrate_s = seconds_since(start);
+    if (counts.scans_reintegrated != plan.scans_reintegrated) {
+      // A scan of the plan that did not come (unreadable, or not matched to its stamp): the
+      // chunks it reaches lack it, as a full re-map's would only if it failed there too.
+      events.warn("integrated " + std::to_string(counts.scans_reintegrated) +
+                  " scans again where " + std::to_string(plan.scans_reintegrated) +
+                  " were planned; the chunks they reach may differ from a full re-map's");
+    }
     start = Clock::now();
     assemble(before.path, scratch, into, plan.changed, counts);
     counts.assemble_s = seconds_since(start);

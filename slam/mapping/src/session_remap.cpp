@@ -58,10 +58,11 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
   return out;
 }
 
-void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
-                    const PassSettings& replay, const config::Config& config,
-                    const std::string& sensor_name, const RunEvents& events,
-                    const std::vector<ScanReintegration>* only) {
+size_t remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& into,
+                      const PassSettings& replay, const config::Config& config,
+                      const std::string& sensor_name, const RunEvents& events,
+                      const std::vector<ScanReintegration>* only) {
+  size_t integrated = 0;
   for (size_t s = 0; s < sessions.size(); ++s) {
     const SessionRemap& session = sessions[s];
     PassSettings settings = replay;
@@ -92,7 +93,9 @@ void remap_sessions(const std::vector<SessionRemap>& sessions, const fs::path& i
          session.description, &session.keyframes},
         events, pipeline);
     if (pass.interrupted) throw Interrupted("interrupted");
+    integrated += pass.frames_mapped;
   }
+  return integrated;
 }
 
 std::vector<KeyframeId> keyframe_ids(const std::vector<MapKeyframe>& keyframes) {

@@ -53,11 +53,11 @@ std::vector<SessionRemap> session_remaps(const SavedMap& saved,
 /// in order, into `into` (replaced). Throws Interrupted, slam::InputError or
 /// std::runtime_error.
 /// With `only`, session s integrates only the scans of (*only)[s], each with the local map
-/// the plan gives it (reintegration_plan.hpp).
-void remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
-                    const PassSettings& replay, const config::Config& config,
-                    const std::string& sensor_name, const RunEvents& events,
-                    const std::vector<ScanReintegration>* only = nullptr);
+/// the plan gives it (reintegration_plan.hpp). Returns the scans integrated.
+size_t remap_sessions(const std::vector<SessionRemap>& sessions, const std::filesystem::path& into,
+                      const PassSettings& replay, const config::Config& config,
+                      const std::string& sensor_name, const RunEvents& events,
+                      const std::vector<ScanReintegration>* only = nullptr);
 
 /// What remap_sessions_where_moved did.
 struct ReintegrationCounts {
@@ -66,10 +66,10 @@ struct ReintegrationCounts {
   std::string why;
   size_t scans = 0;
   size_t scans_moved = 0;
-  size_t scans_reintegrated = 0;
-  size_t chunks_before = 0;   ///< chunks of the map before
-  size_t chunks_changed = 0;  ///< chunks a moved scan reached, made again
-  size_t chunks_kept = 0;     ///< chunks of the map before copied byte for byte
+  size_t scans_reintegrated = 0;  ///< as integrated; a warning where not all the plan named
+  size_t chunks_before = 0;       ///< chunks of the map before
+  size_t chunks_changed = 0;      ///< chunks a moved scan reached, made again
+  size_t chunks_kept = 0;         ///< chunks of the map before copied byte for byte
   double plan_s = 0.0;
   double reintegrate_s = 0.0;
   double assemble_s = 0.0;
