@@ -1,17 +1,20 @@
 // The tile set of a map: tileset.json keeps 3D Tiles 1.1's rules (asset version, boxes that hold
 // their children and content, geometric errors falling to 0 at the full-resolution tiles,
 // content that exists), the full-resolution tiles hold the whole map's mesh, parents fewer
-// triangles than their children, the index lists the tiles, and the GLBs pass the Khronos
-// validator.
+// triangles than their children, the index lists the tiles, the GLBs pass the Khronos
+// validator, and the files are the same whatever the threads.
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
+#include "common/file_bytes.hpp"
 #include "common/gltf_validator.hpp"
 #include "common/test_data.hpp"
 #include "featsense/mesh/marching_cubes.hpp"
@@ -171,6 +174,47 @@ TEST(TileSet, TheOverviewIsTheFinestLevelWithinItsBudget) {
   report = viewer_export::write_tile_set(store, scratch_dir("overview_c").string(), settings);
   EXPECT_EQ(report.overview_level, -1);
   EXPECT_TRUE(report.overview.triangles.empty());
+}
+
+/// Every file under `dir`, by its path below it, with its bytes.
+std::map<std::string, std::string> files_of(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (!entry.is_regular_file()) continue;
+    files[fs::relative(entry.path(), dir).string()] = file_bytes(entry.path());
+  }
+  return files;
+}
+
+TEST(TileSet, TheFilesAndTheOverviewDoNotDependOnTheThreads) {
+  // The nodes' cleanup, levels and files run as tasks beside the meshing: in any order, the
+  // same set.
+  storage::MemoryChunkStore store = tile_scene_store();
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;
+  settings.cleanup.emplace();
+  settings.overview_triangles = mesh::extract_mesh(store, {}).triangles.size();
+  const fs::path one_dir = scratch_dir("threads_one");
+  const fs::path all_dir = scratch_dir("threads_all");
+  viewer_export::TileSetReport one_thread;
+  {
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    one_thread = viewer_export::write_tile_set(store, one_dir.string(), settings);
+  }
+  const viewer_export::TileSetReport all =
+      viewer_export::write_tile_set(store, all_dir.string(), settings);
+  const auto expected = files_of(one_dir);
+  const auto files = files_of(all_dir);
+  ASSERT_EQ(files.size(), expected.size());
+  EXPECT_GT(files.size(), 16u);
+  for (const auto& [path, bytes] : expected) {
+    ASSERT_TRUE(files.count(path)) << path;
+    EXPECT_TRUE(files.at(path) == bytes) << path;
+  }
+  EXPECT_EQ(all.triangles, one_thread.triangles);
+  EXPECT_EQ(all.cleanup->output_triangles, one_thread.cleanup->output_triangles);
+  EXPECT_EQ(all.overview.vertices, one_thread.overview.vertices);
+  EXPECT_EQ(all.overview.triangles, one_thread.overview.triangles);
 }
 
 TEST(TileSet, OneTileIsItsOwnRootAndBadInputIsRefused) {

@@ -1,7 +1,10 @@
 // The tile set: full-resolution tiles meshed one at a time, the quadtree of coarser levels
 // built depth first (each parent as soon as its children are done), the index and the
-// tileset written at the end.
+// tileset written at the end. Meshing reads the store and runs on the caller's thread (it is
+// parallel within); what follows it for a node (cleanup, files, the share for its parent)
+// runs as a task beside the meshing of the next tiles.
 
+#include <tbb/task_group.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -12,6 +15,8 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -86,7 +91,9 @@ class TileSetBuilder {
       present_.push_back(std::move(nodes));
     }
     const auto& root_index = *present_.back().begin();
-    std::optional<Built> root = build_node(top, root_index.first, root_index.second);
+    const std::shared_ptr<Slot> root_slot = build_node(top, root_index.first, root_index.second);
+    tasks_.wait();
+    std::optional<Built> root = std::move(root_slot->built);
     if (!root) throw std::runtime_error("the map has no surface to mesh");
     // A viewer loads the root first: levels above it, each a quarter of the one below, until
     // it is small enough (or simplifying no longer makes it smaller).
@@ -119,6 +126,10 @@ class TileSetBuilder {
     mesh::TriangleMesh for_parent;
     double for_parent_error_m = 0.0;  ///< of for_parent from the content
   };
+  /// A node being built: filled by its task, read once tasks_ has been waited for.
+  struct Slot {
+    std::optional<Built> built;
+  };
 
   bool one_node_at(int level) const {
     const auto& [x0, y0] = *leaves_.begin();
@@ -133,23 +144,37 @@ class TileSetBuilder {
            extension;
   }
 
-  std::optional<Built> build_node(int level, int32_t x, int32_t y) {
-    if (present_[static_cast<std::size_t>(level)].count({x, y}) == 0) return std::nullopt;
+  std::shared_ptr<Slot> build_node(int level, int32_t x, int32_t y) {
+    if (present_[static_cast<std::size_t>(level)].count({x, y}) == 0)
+      return std::make_shared<Slot>();
     return level == 0 ? build_leaf(x, y) : build_parent(level, x, y);
   }
 
-  /// (qx, qy): quadtree coordinates; the tile's own index is (qx, qy) + origin.
-  std::optional<Built> build_leaf(int32_t qx, int32_t qy) {
+  /// (qx, qy): quadtree coordinates; the tile's own index is (qx, qy) + origin. The tile is
+  /// meshed here; the rest runs as a task.
+  std::shared_ptr<Slot> build_leaf(int32_t qx, int32_t qy) {
     const int32_t x = qx + origin_.x;
     const int32_t y = qy + origin_.y;
-    auto start = Clock::now();
+    const auto start = Clock::now();
     mesh::MeshingStats stats;
-    mesh::TriangleMesh full = tiles_.mesh({x, y}, settings_.meshing, &stats);
-    report_.meshing_seconds += seconds_since(start);
-    report_.chunks += stats.chunks;
+    auto full =
+        std::make_shared<mesh::TriangleMesh>(tiles_.mesh({x, y}, settings_.meshing, &stats));
+    {
+      const std::lock_guard<std::mutex> lock(report_mutex_);
+      report_.meshing_seconds += seconds_since(start);
+      report_.chunks += stats.chunks;
+    }
     ++leaves_done_;
     if (settings_.progress) settings_.progress(leaves_done_, leaves_.size());
-    if (full.triangles.empty()) return std::nullopt;
+    auto slot = std::make_shared<Slot>();
+    if (full->triangles.empty()) return slot;
+    tasks_.run([this, slot, full, qx, qy] { slot->built = finish_leaf(*full, qx, qy); });
+    return slot;
+  }
+
+  std::optional<Built> finish_leaf(mesh::TriangleMesh& full, int32_t qx, int32_t qy) {
+    const int32_t x = qx + origin_.x;
+    const int32_t y = qy + origin_.y;
     if (settings_.cleanup) clean_tile(full, qx, qy);
     if (full.triangles.empty()) return std::nullopt;
 
@@ -161,29 +186,39 @@ class TileSetBuilder {
     built.node.triangles = full.triangles.size();
     built.node.content = content_path(0, x, y, ".glb");
     write_content(built.node.content, full);
-    collect_for_overview(0, full);
+    collect_for_overview(0, x, y, full);
     if (settings_.write_ply) {
-      start = Clock::now();
+      const auto start = Clock::now();
       write_ply_mesh((dir_ / content_path(0, x, y, ".ply")).string(), full);
-      report_.writing_seconds += seconds_since(start);
+      add_seconds(report_.writing_seconds, seconds_since(start));
     }
-    report_.tiles += 1;
-    report_.triangles += full.triangles.size();
-    report_.vertices += full.vertices.size();
+    {
+      const std::lock_guard<std::mutex> lock(report_mutex_);
+      report_.tiles += 1;
+      report_.triangles += full.triangles.size();
+      report_.vertices += full.vertices.size();
+    }
     count(built.node);
     simplify_for_parent(full, 0, qx, qy, built);
     return built;
   }
 
-  std::optional<Built> build_parent(int level, int32_t x, int32_t y) {
-    std::vector<Built> children;
+  /// The children are built (their meshing here, the rest as tasks), then the node itself as
+  /// a task once they are done.
+  std::shared_ptr<Slot> build_parent(int level, int32_t x, int32_t y) {
+    std::vector<std::shared_ptr<Slot>> slots;
     for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) {
-        std::optional<Built> child = build_node(level - 1, 2 * x + i, 2 * y + j);
-        if (child) children.push_back(std::move(*child));
-      }
-    if (children.empty()) return std::nullopt;
-    return make_parent(level, x, y, std::move(children));
+      for (int i = 0; i < 2; ++i) slots.push_back(build_node(level - 1, 2 * x + i, 2 * y + j));
+    tasks_.wait();
+    auto children = std::make_shared<std::vector<Built>>();
+    for (const std::shared_ptr<Slot>& slot : slots)
+      if (slot->built) children->push_back(std::move(*slot->built));
+    auto slot = std::make_shared<Slot>();
+    if (children->empty()) return slot;
+    tasks_.run([this, slot, children, level, x, y] {
+      slot->built = make_parent(level, x, y, std::move(*children));
+    });
+    return slot;
   }
 
   /// Node (x, y) at `level` over its children (built, with their shares for it).
@@ -209,7 +244,7 @@ class TileSetBuilder {
     // The kept vertices' normals are those of the surface around each at full resolution;
     // over large triangles they shade as facets. The writer makes area-weighted ones instead.
     content.normals.clear();
-    report_.simplifying_seconds += seconds_since(start);
+    add_seconds(report_.simplifying_seconds, seconds_since(start));
     for (Built& child : children) {
       child.for_parent = {};
       built.node.children.push_back(std::move(child.node));
@@ -217,7 +252,7 @@ class TileSetBuilder {
     built.node.triangles = content.triangles.size();
     built.node.content = content_path(level, x, y, ".glb");
     write_content(built.node.content, content);
-    collect_for_overview(level, content);
+    collect_for_overview(level, x, y, content);
     count(built.node);
     simplify_for_parent(content, level, x, y, built);
     return built;
@@ -239,7 +274,7 @@ class TileSetBuilder {
     mesh::SimplifiedMesh simplified = mesh::simplify_mesh(content, simplify, held);
     built.for_parent = std::move(simplified.mesh);
     built.for_parent_error_m = simplified.error_m;
-    report_.simplifying_seconds += seconds_since(start);
+    add_seconds(report_.simplifying_seconds, seconds_since(start));
   }
 
   /// The four lines where node (qx, qy) at `level` meets its neighbours, as the floats its
@@ -264,6 +299,7 @@ class TileSetBuilder {
     mesh::CleanupSettings cleanup = *settings_.cleanup;
     cleanup.on_cut = [cuts](const Eigen::Vector3f& p) { return cuts.holds(p); };
     const mesh::CleanupReport tile = mesh::clean_mesh(full, cleanup);
+    const std::lock_guard<std::mutex> lock(report_mutex_);
     mesh::CleanupReport& sum = *report_.cleanup;
     sum.input_vertices += tile.input_vertices;
     sum.input_triangles += tile.input_triangles;
@@ -282,9 +318,11 @@ class TileSetBuilder {
     sum.seconds += tile.seconds;
   }
 
-  /// Keeps a copy of a level's content while the level's tiles fit the overview's budget.
-  void collect_for_overview(int level, const mesh::TriangleMesh& content) {
+  /// Keeps a copy of a level's content while the level's tiles fit the overview's budget, by
+  /// node, so that the overview does not depend on the order in which the tasks end.
+  void collect_for_overview(int level, int32_t x, int32_t y, const mesh::TriangleMesh& content) {
     if (settings_.overview_triangles == 0) return;
+    const std::lock_guard<std::mutex> lock(report_mutex_);
     if (overview_parts_.size() <= static_cast<std::size_t>(level))
       overview_parts_.resize(static_cast<std::size_t>(level) + 1);
     LevelParts& parts = overview_parts_[static_cast<std::size_t>(level)];
@@ -295,7 +333,7 @@ class TileSetBuilder {
       parts.meshes.clear();
       return;
     }
-    parts.meshes.push_back(content);
+    parts.meshes.emplace(std::make_pair(x, y), content);
   }
 
   void pick_overview() {
@@ -303,7 +341,7 @@ class TileSetBuilder {
       LevelParts& parts = overview_parts_[level];
       if (parts.over_budget || parts.meshes.empty()) continue;
       std::vector<const mesh::TriangleMesh*> pointers;
-      for (const mesh::TriangleMesh& part : parts.meshes) pointers.push_back(&part);
+      for (const auto& [node, part] : parts.meshes) pointers.push_back(&part);
       report_.overview = mesh::weld_by_position(pointers);
       report_.overview_level = static_cast<int>(level);
       break;
@@ -316,10 +354,17 @@ class TileSetBuilder {
     const fs::path path = dir_ / relative;
     fs::create_directories(path.parent_path());
     write_gltf_mesh(path.string(), content, {}, true);
-    report_.writing_seconds += seconds_since(start);
+    add_seconds(report_.writing_seconds, seconds_since(start));
+  }
+
+  /// Seconds of the tasks, summed over the threads that ran them.
+  void add_seconds(double& total, double seconds) {
+    const std::lock_guard<std::mutex> lock(report_mutex_);
+    total += seconds;
   }
 
   void count(const TileSetNode& node) {
+    const std::lock_guard<std::mutex> lock(report_mutex_);
     while (report_.levels.size() <= static_cast<std::size_t>(node.level)) {
       report_.levels.emplace_back();
       report_.levels.back().level = static_cast<int>(report_.levels.size()) - 1;
@@ -374,12 +419,14 @@ class TileSetBuilder {
   std::size_t leaves_done_ = 0;
   /// Each level's contents while they fit the overview's budget.
   struct LevelParts {
-    std::vector<mesh::TriangleMesh> meshes;
+    std::map<std::pair<int32_t, int32_t>, mesh::TriangleMesh> meshes;
     std::size_t triangles = 0;
     bool over_budget = false;
   };
   std::vector<LevelParts> overview_parts_;
   TileSetReport report_;
+  std::mutex report_mutex_;  ///< report_ and overview_parts_, which the tasks add to
+  tbb::task_group tasks_;
 };
 
 }  // namespace

@@ -85,10 +85,12 @@ struct TileSetReport {
   std::vector<TileSetLevel> levels;  ///< finest first
   /// With cleanup: the tiles' reports summed (counts and seconds; is_* not meaningful).
   std::optional<mesh::CleanupReport> cleanup;
+  /// The marching cubes (on the calling thread, parallel within); the simplification and the
+  /// files run beside them, on other threads, and their seconds are summed over those threads.
   double meshing_seconds = 0.0;
   double simplifying_seconds = 0.0;
   double writing_seconds = 0.0;
-  double seconds = 0.0;
+  double seconds = 0.0;  ///< the whole, wall clock
   TileSetNode root;
   /// With overview_triangles: the finest level within the budget, its tiles welded; -1 and
   /// empty when even the root holds more.
