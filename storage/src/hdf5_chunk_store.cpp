@@ -400,9 +400,9 @@ void Hdf5ChunkStore::write_durable_records(detail::Hdf5MapWriter& writer) const 
   writer.write_sessions(sessions_);
 }
 
-void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
-                 const std::function<bool(const ChunkKey&)>& from_newer,
-                 const Hdf5ChunkStore& older) {
+SpliceCounts splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                         const std::function<bool(const ChunkKey&)>& from_newer,
+                         const Hdf5ChunkStore& older) {
   for (const Hdf5ChunkStore* map : {&newer, &older}) {
     if (map->closed_) throw std::logic_error("splicing a closed map: " + map->path_.string());
     if (map->has_unflushed_writes())
@@ -413,12 +413,19 @@ void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
   }
   check_compatible(older.metadata_, newer.metadata_, older.path_, "cannot splice the map");
   const auto tmp = with_suffix(into, ".tmp");
+  SpliceCounts counts;
   try {
     detail::Hdf5MapWriter writer(tmp, newer.metadata_, newer.settings_.deflate_level);
-    for (const ChunkKey& key : newer.present_)
-      if (from_newer(key)) newer.write_durable_chunk(writer, key);
-    for (const ChunkKey& key : older.present_)
-      if (!from_newer(key)) older.write_durable_chunk(writer, key);
+    for (const ChunkKey& key : newer.present_) {
+      if (!from_newer(key)) continue;
+      newer.write_durable_chunk(writer, key);
+      ++counts.from_newer;
+    }
+    for (const ChunkKey& key : older.present_) {
+      if (from_newer(key)) continue;
+      older.write_durable_chunk(writer, key);
+      ++counts.from_older;
+    }
     newer.write_durable_records(writer);
     writer.close();
   } catch (...) {
@@ -429,6 +436,7 @@ void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
   // A journal left by an earlier map at `into` would be replayed over this one.
   std::filesystem::remove(with_suffix(into, ".journal"));
   detail::replace_file(tmp, into);
+  return counts;
 }
 
 void Hdf5ChunkStore::close() {

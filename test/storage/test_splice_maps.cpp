@@ -59,10 +59,11 @@ hsize_t stored_size(const fs::path& map, const ChunkKey& key) {
 }
 
 /// Both maps opened read-only, as a closed map is spliced.
-void splice_files(const fs::path& into, const fs::path& newer_path, const fs::path& older_path) {
+SpliceCounts splice_files(const fs::path& into, const fs::path& newer_path,
+                          const fs::path& older_path) {
   const Hdf5ChunkStore older(older_path);
   const Hdf5ChunkStore newer(newer_path);
-  splice_maps(into, newer, changed, older);
+  return splice_maps(into, newer, changed, older);
 }
 
 TEST(SpliceMaps, TakesTheChosenChunksFromTheNewerAndTheRestFromTheOlder) {
@@ -70,7 +71,9 @@ TEST(SpliceMaps, TakesTheChosenChunksFromTheNewerAndTheRestFromTheOlder) {
   const fs::path older_path = write_map(dir / "older.h5", kOlder, 1);
   const fs::path newer_path = write_map(dir / "newer.h5", kNewer, 2);
   const fs::path into = dir / "spliced.h5";
-  splice_files(into, newer_path, older_path);
+  const SpliceCounts counts = splice_files(into, newer_path, older_path);
+  EXPECT_EQ(counts.from_newer, 3u);  // (1,0,0), (2,0,0), (5,5,5)
+  EXPECT_EQ(counts.from_older, 2u);  // (0,0,0), (0,1,0)
   Hdf5ChunkStore spliced(into);
   const std::vector<ChunkKey> expected_keys = {
       {0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {2, 0, 0}, {5, 5, 5}};

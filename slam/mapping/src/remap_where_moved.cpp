@@ -53,12 +53,11 @@ void assemble(const fs::path& before_path, const fs::path& scratch_path, const f
               const ChunkSet& changed, ReintegrationCounts& counts) {
   const storage::Hdf5ChunkStore scratch(scratch_path);
   const storage::Hdf5ChunkStore before(before_path);
-  const auto is_changed = [&](const storage::ChunkKey& key) { return changed.count(key) > 0; };
-  for (const storage::ChunkKey& key : scratch.keys()) counts.chunks_changed += is_changed(key);
-  const std::vector<storage::ChunkKey> before_keys = before.keys();
-  counts.chunks_before = before_keys.size();
-  for (const storage::ChunkKey& key : before_keys) counts.chunks_kept += !is_changed(key);
-  storage::splice_maps(into, scratch, is_changed, before);
+  counts.chunks_before = before.keys().size();
+  const storage::SpliceCounts spliced = storage::splice_maps(
+      into, scratch, [&](const storage::ChunkKey& key) { return changed.count(key) > 0; }, before);
+  counts.chunks_changed = spliced.from_newer;
+  counts.chunks_kept = spliced.from_older;
 }
 
 }  // namespace

@@ -55,9 +55,14 @@ class Hdf5ChunkStore;
 /// copied as stored, still compressed; what is still in its journal is encoded afresh. Both
 /// maps must have nothing unflushed (std::logic_error) and the same voxel size, tau and
 /// encoding (std::runtime_error naming both values); `into` must be neither of them.
-void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
-                 const std::function<bool(const ChunkKey&)>& from_newer,
-                 const Hdf5ChunkStore& older);
+/// Returns the chunks taken from each.
+struct SpliceCounts {
+  std::size_t from_newer = 0;
+  std::size_t from_older = 0;
+};
+SpliceCounts splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                         const std::function<bool(const ChunkKey&)>& from_newer,
+                         const Hdf5ChunkStore& older);
 
 class Hdf5ChunkStore final : public ChunkStore {
  public:
@@ -111,9 +116,9 @@ class Hdf5ChunkStore final : public ChunkStore {
   std::size_t journal_bytes() const;
 
  private:
-  friend void splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
-                          const std::function<bool(const ChunkKey&)>& from_newer,
-                          const Hdf5ChunkStore& older);
+  friend SpliceCounts splice_maps(const std::filesystem::path& into, const Hdf5ChunkStore& newer,
+                                  const std::function<bool(const ChunkKey&)>& from_newer,
+                                  const Hdf5ChunkStore& older);
 
   struct Location {
     bool in_journal = false;  ///< else in the .h5
