@@ -62,6 +62,9 @@ nlohmann::json refine_json(const mapping::PassResult& run,
             {"fits_worse", counts.worse_fit}}},
           // Stretches the sensor stood still through: not registered (nothing drifted).
           {"stood_still", counts.stood},
+          // Refined stretches that kept the odometry's motion along a direction their points
+          // hardly constrain (refine.min_constraint_ratio).
+          {"weak_directions_held", counts.weak_directions_held},
           // How far the registrations moved the odometry's guess (its drift over a stretch).
           {"correction_m", {{"median", steps_m.median_ms}, {"max", steps_m.max_ms}}},
           {"correction_deg", {{"median", steps_deg.median_ms}, {"max", steps_deg.max_ms}}},

@@ -306,6 +306,8 @@ std::vector<KeySpec> make_specs() {
                  {0.0, 10000.0, true}),
       number_key("refine.voxel", &Config::refine, &RefineConfig::voxel_m, {0.02, 5.0}),
       integer_key("refine.max_scans", &Config::refine, &RefineConfig::max_scans, 2, 1000),
+      number_key("refine.min_constraint_ratio", &Config::refine,
+                 &RefineConfig::min_constraint_ratio, {0.0, 1.0}),
       bool_key("loop.enabled", &Config::loop, &LoopConfig::enabled),
       number_key("loop.keyframe_distance", &Config::loop, &LoopConfig::keyframe_distance_m,
                  {0.0, 1000.0, true}),

@@ -10,6 +10,7 @@ RefineSettings from_config(const config::Config& config) {
   settings.voxel_m = config.refine.voxel_m;
   settings.max_scans = static_cast<size_t>(config.refine.max_scans);
   settings.vgicp = stretch_vgicp(settings.voxel_m);
+  settings.vgicp.min_constraint_ratio = config.refine.min_constraint_ratio;
   return settings;
 }
 

@@ -76,6 +76,7 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::register_stretch(
   registration.iterations = result.iterations;
   registration.guess_fit = result.guess_fit;
   registration.result_fit = result.result_fit;
+  registration.weak_directions = result.weak_directions;
   std::vector<Eigen::Isometry3d> poses;
   for (size_t i = 0; i < stretch.size(); ++i) {
     poses.push_back(to_local.inverse() *
@@ -148,6 +149,7 @@ std::vector<Eigen::Isometry3d> SegmentRefiner::refine() {
       break;
     case RefineOutcome::refined:
       ++counts_.refined;
+      if (registration.weak_directions > 0) ++counts_.weak_directions_held;
       break;
     case RefineOutcome::not_converged:
       ++counts_.not_converged;

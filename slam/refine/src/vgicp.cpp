@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "featsense/slam/refine/weak_directions.hpp"
 #include "featsense/slam/trajectory/rigid_pose.hpp"
 
 namespace featsense::slam::refine {
@@ -177,6 +178,21 @@ VgicpLinearization evaluate_parts(const std::vector<Part>& parts,
   return sum;
 }
 
+/// Each part's terms over `target`'s voxels at its current pose, with those poses.
+struct PartTerms {
+  std::vector<std::vector<Correspondence>> terms;
+  std::vector<Eigen::Isometry3d> poses;
+};
+
+PartTerms terms_at(const VoxelGaussians& target, const std::vector<Part>& parts) {
+  PartTerms held;
+  for (const Part& part : parts) {
+    held.terms.push_back(correspond(target, *part.cloud, part.T));
+    held.poses.push_back(part.T);
+  }
+  return held;
+}
+
 /// The parts' poses after a shared step.
 std::vector<Eigen::Isometry3d> stepped(const std::vector<Part>& parts, const Vector6d& step) {
   std::vector<Eigen::Isometry3d> poses;
@@ -196,12 +212,9 @@ std::vector<Vector6d> solve_parts(const VoxelGaussians& target, std::vector<Part
     ++result.iterations;
     // The terms are found again at every iteration and held while the steps are tried, so
     // that a step is judged on the same terms as the cost it is compared with.
-    std::vector<std::vector<Correspondence>> terms;
-    std::vector<Eigen::Isometry3d> poses;
-    for (const Part& part : parts) {
-      terms.push_back(correspond(target, *part.cloud, part.T));
-      poses.push_back(part.T);
-    }
+    const PartTerms held = terms_at(target, parts);
+    const std::vector<std::vector<Correspondence>>& terms = held.terms;
+    const std::vector<Eigen::Isometry3d>& poses = held.poses;
     const VgicpLinearization at = evaluate_parts(parts, terms, poses, true);
     if (at.terms < 6) break;  // too few correspondences to fix a pose
     bool accepted = false;
@@ -338,6 +351,40 @@ VgicpFit measure_fit(const VoxelGaussians& target, const std::vector<Part>& part
 
 }  // namespace
 
+namespace {
+
+/// The shared correction's Hessian at the solution over the finest voxels decides which of its
+/// directions the clouds constrain; the steps lose their part along the weak ones and the parts
+/// are moved again from their guesses.
+void keep_weak_directions(const VoxelGaussians& finest, const std::vector<SharedSource>& sources,
+                          double min_ratio, std::vector<Part>& parts, SharedVgicpResult& result) {
+  const PartTerms held = terms_at(finest, parts);
+  const VgicpLinearization at = evaluate_parts(parts, held.terms, held.poses, true);
+  // The turns' lever arm: the points' RMS distance from the centre of rotation (the origin).
+  double squares = 0.0;
+  size_t points = 0;
+  for (const Part& part : parts) {
+    for (const Eigen::Vector3d& p : part.cloud->points) squares += (part.T * p).squaredNorm();
+    points += part.cloud->size();
+  }
+  const double lever_arm_m = points > 0 ? std::sqrt(squares / static_cast<double>(points)) : 0.0;
+  const WeakDirections weak = weak_directions(at.hessian, lever_arm_m, min_ratio);
+  result.weak_directions = weak.count;
+  result.weakest_ratio = weak.weakest_ratio;
+  if (weak.count == 0) return;
+  for (Vector6d& step : result.steps) step = weak.keep_strong * step;
+  // parts holds the sources with a cloud, in their order.
+  size_t next = 0;
+  for (const SharedSource& source : sources) {
+    if (next < parts.size() && source.cloud == parts[next].cloud) {
+      parts[next].T = apply_steps(source.guess, result.steps, source.share);
+      ++next;
+    }
+  }
+}
+
+}  // namespace
+
 SharedVgicpResult align_shared(const VgicpTarget& target, const std::vector<SharedSource>& sources,
                                const VgicpSettings& settings) {
   SharedVgicpResult result;
@@ -362,6 +409,10 @@ SharedVgicpResult align_shared(const VgicpTarget& target, const std::vector<Shar
   }
   result.converged = solved.converged;
   result.iterations = solved.iterations;
+  if (settings.min_constraint_ratio > 0.0 && !result.steps.empty()) {
+    keep_weak_directions(target.levels.back(), sources, settings.min_constraint_ratio, parts,
+                         result);
+  }
   result.result_fit = measure_fit(target.fitness, parts, settings.inlier_distance_m);
   for (size_t i = 0; i < sources.size(); ++i) {
     result.poses[i] = apply_steps(sources[i].guess, result.steps, sources[i].share);

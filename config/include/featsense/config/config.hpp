@@ -111,6 +111,7 @@ struct RefineConfig {
   double distance_m = 5.0;
   double voxel_m = 0.5;
   int max_scans = 64;
+  double min_constraint_ratio = 0.005;  ///< see default.yaml
 };
 
 struct LoopConfig {

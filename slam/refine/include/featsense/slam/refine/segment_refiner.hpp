@@ -33,6 +33,7 @@ inline VgicpSettings stretch_vgicp(double voxel_m) {
   settings.step_tolerance_m = 5e-4;
   settings.inlier_distance_m = 0.1;
   settings.fitness_voxel_m = std::max(0.5, 2.0 * voxel_m);
+  settings.min_constraint_ratio = config::RefineConfig{}.min_constraint_ratio;
   return settings;
 }
 
@@ -85,6 +86,8 @@ struct StretchRegistration {
   int iterations = 0;
   double step_m = 0.0;  ///< how far the result moved the stretch's last scan
   double step_deg = 0.0;
+  /// Directions of the correction left at the odometry's motion as too weakly constrained.
+  int weak_directions = 0;
   double ms = 0.0;  ///< the target's voxels and the registration
 };
 
@@ -96,6 +99,8 @@ struct RefineCounts {
   size_t too_far = 0;
   size_t worse_fit = 0;
   size_t stood = 0;  ///< stretches the sensor stood still through: nothing drifted to correct
+  /// Refined stretches whose correction kept the odometry's motion along a weak direction.
+  size_t weak_directions_held = 0;
   std::vector<StretchRegistration> stretches;
 };
 

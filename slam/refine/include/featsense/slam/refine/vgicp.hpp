@@ -33,6 +33,10 @@ struct VgicpSettings {
   /// The voxel size the fitness is measured with (align() only): coarse enough that a
   /// sampled surface fills its voxels, fine enough that a voxel mostly holds one surface.
   double fitness_voxel_m = 0.5;
+  /// align_shared only: a direction of the correction constrained less than this fraction as
+  /// firmly as the best-constrained one keeps the guesses (weak_directions.hpp); 0 corrects
+  /// every direction.
+  double min_constraint_ratio = 0.0;
 };
 
 /// What a registration found, and how well: for the fitness check of the refinement and the
@@ -111,6 +115,10 @@ struct SharedVgicpResult {
   int iterations = 0;
   VgicpFit guess_fit;   ///< all sources at their guesses, on the fitness voxels
   VgicpFit result_fit;  ///< at the result
+  /// Directions of the correction left at the guesses as too weakly constrained
+  /// (min_constraint_ratio), and the weakest direction's share of the strongest.
+  int weak_directions = 0;
+  double weakest_ratio = 1.0;
 };
 
 /// Registers `sources` to `target` together, coarse to fine: one correction, shared out.
