@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -52,6 +53,49 @@ TEST(ImuSimulator, OnACircleReadsTheCentripetalAccelerationAndTheTurnRate) {
     EXPECT_LT((s.accel_mps2 - expected).norm(), 0.02);  // the spline is not quite a circle
     EXPECT_NEAR(s.gyro_radps.z(), 0.25, 0.005);
   }
+}
+
+TEST(ImuSimulator, ReadingsOfAPathOfSampledPosesIntegrateToItsChangeOfVelocity) {
+  // A TUM-like path, a pose every 50 ms: straight along x at 4 m/s, then straight along y. Its
+  // velocity changes at once at the samples; the accelerometer, read every 10 ms, must still
+  // integrate to that change (a reading that saw each bend from one sample only counted it
+  // twice).
+  std::vector<StampedPose> poses;
+  for (int i = 0; i <= 80; ++i) {
+    const double t = 0.05 * i;
+    const double d = 4.0 * t;
+    StampedPose sample;
+    sample.t_s = t;
+    const double turn = std::clamp((t - 1.5) / 1.0, 0.0, 1.0) * M_PI / 2.0;
+    // Round the corner with ten chords of a 2.5 m arc (yaw from 0 to 90 deg over 1 s).
+    const Eigen::Vector3d p =
+        t < 1.5   ? Eigen::Vector3d(d, 0.0, 0.0)
+        : t < 2.5 ? Eigen::Vector3d(6.0 + 2.5 * std::sin(turn), 2.5 - 2.5 * std::cos(turn), 0.0)
+                  : Eigen::Vector3d(8.5, 2.5 + 4.0 * (t - 2.5), 0.0);
+    sample.T_map_sensor =
+        Eigen::Translation3d(p) * Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ());
+    poses.push_back(sample);
+  }
+  const std::unique_ptr<PoseCurve> path = make_sampled_trajectory(poses);
+  const std::vector<ImuSample> samples = simulate_imu(*path, ImuModel::exact(), 1, 0.5, 3.5, 0);
+  // Trapezoid over [1, 3]: the world-frame acceleration, gravity removed.
+  Eigen::Vector3d change = Eigen::Vector3d::Zero();
+  for (size_t i = 1; i < samples.size(); ++i) {
+    const double t0 = static_cast<double>(samples[i - 1].stamp_ns) * 1e-9;
+    const double t1 = static_cast<double>(samples[i].stamp_ns) * 1e-9;
+    if (t0 < 1.0 - 1e-9 || t1 > 3.0 + 1e-9) continue;
+    auto world = [&](const ImuSample& s, double t) {
+      return (path->pose(t).rotation() * s.accel_mps2 - kStandardGravity * Eigen::Vector3d::UnitZ())
+          .eval();
+    };
+    change += 0.5 * (t1 - t0) * (world(samples[i - 1], t0) + world(samples[i], t1));
+  }
+  // From 4 m/s along x to the chord speed along y.
+  const Eigen::Vector3d before =
+      (poses[20].T_map_sensor.translation() - poses[19].T_map_sensor.translation()) / 0.05;
+  const Eigen::Vector3d after =
+      (poses[61].T_map_sensor.translation() - poses[60].T_map_sensor.translation()) / 0.05;
+  EXPECT_LT((change - (after - before)).norm(), 1e-6) << change.transpose();
 }
 
 TEST(ImuSimulator, NoiseAndBiasAreThoseOfTheModelAndRepeatable) {

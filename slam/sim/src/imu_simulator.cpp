@@ -64,10 +64,19 @@ std::vector<ImuSample> simulate_imu(const PoseCurve& path, const ImuModel& model
     // so a centred step would see a stop that is not in it).
     const double centre = std::clamp(t, kStep_s, std::max(kStep_s, duration - kStep_s));
     const Eigen::Isometry3d before = path.pose(centre - kStep_s);
-    const Eigen::Isometry3d at = path.pose(centre);
     const Eigen::Isometry3d after = path.pose(centre + kStep_s);
+    // The acceleration as an accelerometer reports it: filtered to its sample rate. The
+    // second difference over one sample period each way is the acceleration averaged with a
+    // triangle as wide as two periods; the samples' triangles add up to one everywhere, so the
+    // readings integrate to the path's change of velocity exactly, also where a path of
+    // sampled poses (a TUM file) bends at once between two samples. A narrower stencil would
+    // see such a bend only from the samples next to it, and count it twice or not at all.
+    const double period_s = 1.0 / model.rate_hz;
+    const double middle = std::clamp(t, period_s, std::max(period_s, duration - period_s));
     const Eigen::Vector3d acceleration =
-        (after.translation() - 2.0 * at.translation() + before.translation()) / (kStep_s * kStep_s);
+        (path.pose(middle + period_s).translation() - 2.0 * path.pose(middle).translation() +
+         path.pose(middle - period_s).translation()) /
+        (period_s * period_s);
     const Eigen::Matrix3d R = path.pose(t).rotation();
     const Eigen::AngleAxisd turn(before.rotation().transpose() * after.rotation());
     ImuSample sample;
