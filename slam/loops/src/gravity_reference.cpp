@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <utility>
+#include <vector>
 
 #include "featsense/slam/loops/trajectory_correction.hpp"
 
@@ -48,6 +50,38 @@ class PathAt {
  private:
   const std::vector<int64_t>& stamps_;
   const std::vector<Eigen::Isometry3d>& poses_;
+};
+
+/// The weight with which the acceleration at time t enters the difference of the mean
+/// velocities over [a0, a1] and [b0, b1] (a0 < a1 and a0 < b0 < b1): with
+/// v(t) = v(a0) + int_a0^t a, mean_b - mean_a = int a(s) w(s) ds, where w rises linearly from
+/// 0 at a0 to 1 at a1, is 1 up to b0 and falls to 0 at b1 (both parts added where the
+/// baselines overlap). Its integral is the time between the baselines' middles.
+struct AccelerationKernel {
+  int64_t a0, a1, b0, b1;
+
+  double weight(double t_s) const {
+    const double A0 = seconds(a0), A1 = seconds(a1), B0 = seconds(b0), B1 = seconds(b1);
+    double w = 0.0;
+    if (t_s >= A0 && t_s < B0) w += 1.0;  // half open: the last part takes over at B0
+    if (t_s >= A0 && t_s <= A1) w -= (A1 - t_s) / (A1 - A0);
+    if (t_s >= B0 && t_s <= B1) w += (B1 - t_s) / (B1 - B0);
+    return w;
+  }
+
+  /// [t0, t1] clipped to [a0, b1] and cut at the kernel's corners: pieces on which it is
+  /// linear.
+  std::vector<std::pair<int64_t, int64_t>> pieces(int64_t t0, int64_t t1) const {
+    std::vector<int64_t> cuts = {std::max(t0, a0), std::min(t1, b1)};
+    if (cuts[1] <= cuts[0]) return {};
+    for (const int64_t corner : {a1, b0})
+      if (corner > cuts[0] && corner < cuts[1]) cuts.push_back(corner);
+    std::sort(cuts.begin(), cuts.end());
+    std::vector<std::pair<int64_t, int64_t>> out;
+    for (size_t i = 1; i < cuts.size(); ++i)
+      if (cuts[i] > cuts[i - 1]) out.push_back({cuts[i - 1], cuts[i]});
+    return out;
+  }
 };
 
 }  // namespace
@@ -97,46 +131,60 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
     const PathAt::Velocity v_start = path_at.between(a0, a1);
     const PathAt::Velocity v_end = path_at.between(b0, b1);
     if (v_end.at_ns <= v_start.at_ns) continue;
-    // The samples over [start, end], and one on either side to reach its ends.
+    // The difference of two mean velocities is the acceleration weighed by a kernel that
+    // rises over the first baseline, is 1 between them and falls over the last
+    // (AccelerationKernel): the accelerometer is averaged with those weights, which is exact
+    // for any motion, where a plain mean between the baselines' middles is off by a / 8 x
+    // baseline wherever the acceleration steps (a car turning into a bend).
+    const AccelerationKernel kernel{path_stamps_ns[a0], path_stamps_ns[a1], path_stamps_ns[b0],
+                                    path_stamps_ns[b1]};
+    // The samples over the kernel, and one on either side to reach its ends.
     const auto after_start =
-        std::upper_bound(samples.begin(), samples.end(), v_start.at_ns,
+        std::upper_bound(samples.begin(), samples.end(), kernel.a0,
                          [](int64_t t, const ImuSample& s) { return t < s.stamp_ns; });
-    const auto end_sample = std::lower_bound(after_start, samples.end(), v_end.at_ns, by_stamp);
+    const auto end_sample = std::lower_bound(after_start, samples.end(), kernel.b1, by_stamp);
     if (after_start == samples.begin() || end_sample == samples.end()) continue;
     const auto first = std::prev(after_start);
     const auto last = std::next(end_sample);
     const auto n = static_cast<size_t>(std::distance(after_start, end_sample));
-    if (n < 10 || 2 * n < wanted || first->stamp_ns < v_start.at_ns - 2 * period_ns ||
-        end_sample->stamp_ns > v_end.at_ns + 2 * period_ns)
+    if (n < 10 || 2 * n < wanted || first->stamp_ns < kernel.a0 - 2 * period_ns ||
+        end_sample->stamp_ns > kernel.b1 + 2 * period_ns)
       continue;
     const Eigen::Matrix3d R_k_map = path_at(keyframe_stamps_ns[k]).rotation().transpose();
     GravityObservation o;
     o.node = k;
     o.samples = n;
-    // The trapezoid rule over [start, end] between the samples, exact for a force that
-    // changes linearly between them: a sample is a reading at its instant, not a period's.
+    // Between two samples the force and the rotation change linearly (a sample is a reading
+    // at its instant, not a period's) and the kernel is linear between its corners: their
+    // product, a quadratic, is integrated exactly by Simpson's rule on each piece.
     o.mean_force.setZero();
     o.bias_rotation.setZero();
     Eigen::Matrix3d R_previous = R_k_map * path_at(first->stamp_ns).rotation();
     for (auto s = first, next = std::next(first); next != last; s = next, ++next) {
       const Eigen::Matrix3d R_next = R_k_map * path_at(next->stamp_ns).rotation();
-      const double t0 = seconds(s->stamp_ns), t1 = seconds(next->stamp_ns);
-      const double u = std::max(t0, seconds(v_start.at_ns));
-      const double w = std::min(t1, seconds(v_end.at_ns));
-      if (w > u) {
-        const auto at = [&](double t, const auto& a, const auto& b) {
-          const double f = (t - t0) / (t1 - t0);
-          return ((1.0 - f) * a + f * b).eval();
-        };
-        const Eigen::Vector3d force0 = R_previous * s->accel_mps2;
-        const Eigen::Vector3d force1 = R_next * next->accel_mps2;
-        o.mean_force += 0.5 * (w - u) * (at(u, force0, force1) + at(w, force0, force1));
-        o.bias_rotation += 0.5 * (w - u) * (at(u, R_previous, R_next) + at(w, R_previous, R_next));
+      const int64_t t0 = s->stamp_ns, t1 = next->stamp_ns;
+      const Eigen::Vector3d force0 = R_previous * s->accel_mps2;
+      const Eigen::Vector3d force1 = R_next * next->accel_mps2;
+      const auto linear = [&](double t, const auto& a, const auto& b) {
+        const double f = (t - seconds(t0)) / seconds(t1 - t0);
+        return ((1.0 - f) * a + f * b).eval();
+      };
+      for (const auto& [u, w] : kernel.pieces(t0, t1)) {
+        const double p0 = seconds(u), p1 = seconds(w), middle = 0.5 * (p0 + p1);
+        const double width = (p1 - p0) / 6.0;
+        const double w0 = kernel.weight(p0), wm = kernel.weight(middle), w1 = kernel.weight(p1);
+        o.mean_force +=
+            width * (w0 * linear(p0, force0, force1) + 4.0 * wm * linear(middle, force0, force1) +
+                     w1 * linear(p1, force0, force1));
+        o.bias_rotation += width * (w0 * linear(p0, R_previous, R_next) +
+                                    4.0 * wm * linear(middle, R_previous, R_next) +
+                                    w1 * linear(p1, R_previous, R_next));
       }
       R_previous = R_next;
     }
     const int64_t start = v_start.at_ns;
     const int64_t end = v_end.at_ns;
+    // The kernel's area: the time between the two means' middles.
     const double duration = seconds(end - start);
     o.mean_force /= duration;
     o.bias_rotation /= duration;
