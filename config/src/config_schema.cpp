@@ -293,6 +293,8 @@ std::vector<KeySpec> make_specs() {
                  {1.0, 10000.0}),
       number_key("odometry.max_correspondence_distance", &Config::odometry,
                  &OdometryConfig::max_correspondence_distance_m, {0.0, 100.0, true}),
+      number_key("odometry.plane_tolerance", &Config::odometry, &OdometryConfig::plane_tolerance_m,
+                 {0.0, 10.0, true}),
       number_key("odometry.huber_loss", &Config::odometry, &OdometryConfig::huber_loss_m,
                  {0.0, 100.0, true}),
       number_key("odometry.degeneracy_threshold", &Config::odometry,

@@ -10,6 +10,7 @@ OdometrySettings from_config(const config::Config& config) {
   s.surface_voxel_m = c.surface_voxel_m;
   s.map_radius_m = c.map_radius_m;
   s.max_correspondence_distance_m = c.max_correspondence_distance_m;
+  s.plane_tolerance_m = c.plane_tolerance_m;
   s.huber_loss_m = c.huber_loss_m;
   s.degeneracy_threshold = c.degeneracy_threshold;
   s.max_speed_m_s = c.max_speed_m_s;

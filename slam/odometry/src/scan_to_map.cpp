@@ -148,7 +148,7 @@ struct AssociationCache {
 };
 
 Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& points, double period_s,
-                          const Eigen::Isometry3d& T, double max_distance,
+                          const Eigen::Isometry3d& T, double max_distance, double plane_tolerance,
                           AssociationCache& cache) {
   Correspondences c;
   c.lines = match<PointToLine>(
@@ -169,8 +169,8 @@ Correspondences associate(const LocalFeatureMap& map, const TimedFeatures& point
       [&](const Eigen::Vector3d& x, std::vector<Eigen::Vector3d>& near) {
         map.nearest_surfaces(x, kNeighbours, max_distance, near);
       },
-      [](const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
-        const auto plane = fit_plane(near);
+      [plane_tolerance](const std::vector<Eigen::Vector3d>& near) -> std::optional<PointToPlane> {
+        const auto plane = fit_plane(near, plane_tolerance);
         if (!plane) return std::nullopt;
         PointToPlane residual;
         residual.normal = plane->normal;
@@ -322,7 +322,7 @@ Eigen::Isometry3d register_to_map(const LocalFeatureMap& map, const TimedFeature
                                                                     start.elapsed_s, start.twist))
                                         : raw;
     c = associate(map, points, deskew ? start.elapsed_s : 0.0, pose,
-                  settings.max_correspondence_distance_m, cache);
+                  settings.max_correspondence_distance_m, settings.plane_tolerance_m, cache);
     result.timing.association_ms += ms_since(association_start);
     if (c.size() < kMinCorrespondences) {
       result.edge_correspondences = c.lines.size();

@@ -100,6 +100,7 @@ struct OdometryConfig {
   double surface_voxel_m = 0.4;  ///< voxel of the local surface map and of the scan's surfaces
   double map_radius_m = 50.0;    ///< map points farther than this from the sensor are dropped
   double max_correspondence_distance_m = 1.0;  ///< the 5 neighbours lie within this
+  double plane_tolerance_m = 0.05;             ///< see default.yaml
   double huber_loss_m = 0.1;                   ///< residuals beyond this count linearly
   double degeneracy_threshold = 0.002;         ///< see default.yaml
   double max_speed_m_s = 30.0;  ///< larger corrections of the prediction are divergence

@@ -22,6 +22,8 @@ struct OdometrySettings {
   double surface_voxel_m = detail::kDefaultOdometry.surface_voxel_m;
   double map_radius_m = detail::kDefaultOdometry.map_radius_m;
   double max_correspondence_distance_m = detail::kDefaultOdometry.max_correspondence_distance_m;
+  /// A surface point's neighbours all lie within this of their plane (fit_plane).
+  double plane_tolerance_m = detail::kDefaultOdometry.plane_tolerance_m;
   double huber_loss_m = detail::kDefaultOdometry.huber_loss_m;
   double degeneracy_threshold = detail::kDefaultOdometry.degeneracy_threshold;
   double max_speed_m_s = detail::kDefaultOdometry.max_speed_m_s;
