@@ -159,6 +159,7 @@ struct Part {
   const GaussianCloud* cloud;
   Eigen::Isometry3d T;
   double share;
+  size_t source = 0;  ///< its index among align_shared's sources
 };
 
 /// The cost of all parts over their fixed terms and, when `derivatives`, its gradient and
@@ -373,14 +374,8 @@ void keep_weak_directions(const VoxelGaussians& finest, const std::vector<Shared
   result.weakest_ratio = weak.weakest_ratio;
   if (weak.count == 0) return;
   for (Vector6d& step : result.steps) step = weak.keep_strong * step;
-  // parts holds the sources with a cloud, in their order.
-  size_t next = 0;
-  for (const SharedSource& source : sources) {
-    if (next < parts.size() && source.cloud == parts[next].cloud) {
-      parts[next].T = apply_steps(source.guess, result.steps, source.share);
-      ++next;
-    }
-  }
+  for (Part& part : parts)
+    part.T = apply_steps(sources[part.source].guess, result.steps, part.share);
 }
 
 }  // namespace
@@ -389,10 +384,11 @@ SharedVgicpResult align_shared(const VgicpTarget& target, const std::vector<Shar
                                const VgicpSettings& settings) {
   SharedVgicpResult result;
   std::vector<Part> parts;
-  for (const SharedSource& source : sources) {
+  for (size_t i = 0; i < sources.size(); ++i) {
+    const SharedSource& source = sources[i];
     result.poses.push_back(source.guess);
     if (source.cloud && source.cloud->size() > 0 && source.guess.matrix().allFinite()) {
-      parts.push_back({source.cloud, source.guess, source.share});
+      parts.push_back({source.cloud, source.guess, source.share, i});
     }
   }
   if (parts.empty() || target.levels.empty() || target.levels.back().size() == 0) return result;
