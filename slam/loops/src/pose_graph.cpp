@@ -84,7 +84,7 @@ class GravityCost {
     const Vector3 b = basis_.template cast<T>() * Eigen::Map<const Eigen::Matrix<T, 2, 1>>(bias);
     const Vector3 up_node =
         (o_.mean_force.template cast<T>() - o_.bias_rotation.template cast<T>() * b -
-         o_.velocity_change.template cast<T>()) /
+         o_.path_acceleration.template cast<T>()) /
         length_;
     const Vector3 up_map = r_node * up_node;
     const T tilt[3] = {map_tilt[0], map_tilt[1], T(0)};

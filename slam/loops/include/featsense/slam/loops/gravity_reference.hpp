@@ -3,11 +3,12 @@
 /// a tilt of a few hundredths of a degree in the odometry's first metres tilts the whole map,
 /// and every loop ties the rest to it. An IMU's accelerometer measures the specific force
 /// f = R^T (a + g up); averaged over a window around a keyframe and turned into the keyframe's
-/// frame with the odometry's relative rotations, less the odometry's change of velocity over
-/// the window, it leaves the up direction in that frame:
-///   up_k = mean_s(R_k^T R_s f_s) - mean_s(R_k^T R_s) b - R_k^T (v_end - v_start) / T,
+/// frame with the odometry's relative rotations, less the odometry's acceleration over the
+/// window (the same weighted mean of it, from a quadratic fitted to every position in the
+/// window), it leaves the up direction in that frame:
+///   up_k = mean_s(R_k^T R_s f_s) - mean_s(R_k^T R_s) b - R_k^T a_odometry,
 /// with b the accelerometer's constant bias (a graph variable, observable once the path turns).
-/// Only relative rotations and velocities of the odometry enter, which it measures well; the
+/// Only relative rotations and positions of the odometry enter, which it measures well; the
 /// window's length averages the accelerometer's noise.
 
 #include <Eigen/Core>
@@ -26,14 +27,10 @@ struct GravitySettings {
   bool enabled = config::LoopConfig{}.gravity;  ///< loop.gravity
   /// The IMU samples averaged around each keyframe, seconds (loop.gravity_window).
   double window_s = config::LoopConfig{}.gravity_window_s;
-  /// Velocities from the positions this far apart, seconds. A mean velocity stands for the
-  /// instant velocity at its middle up to jerk x baseline^2 / 24: at 0.4 s a bend's jerk of
-  /// 1 m/s^3 reads as a tilt of 0.02 deg, at 0.2 s a quarter of it; shorter lets the odometry's
-  /// position noise through.
-  double velocity_baseline_s = 0.2;
-  /// The accelerometer's white noise per sample, and the odometry's velocity error.
+  /// The accelerometer's white noise per sample, and the error of each of the odometry's
+  /// positions against its neighbours' (its scan-to-scan jitter, not its drift).
   double accel_noise_mps2 = 0.02;
-  double velocity_sigma_mps = 0.01;
+  double position_sigma_m = 0.005;
   /// A floor on each observation's error (what the model leaves out), m/s^2.
   double min_sigma_mps2 = 0.002;
   /// The prior on the accelerometer's bias, m/s^2 per axis.
@@ -41,18 +38,19 @@ struct GravitySettings {
 };
 
 /// The up direction seen around one keyframe (graph node), in its sensor frame, as a function
-/// of the bias b: mean_force - bias_rotation * b - velocity_change.
+/// of the bias b: mean_force - bias_rotation * b - path_acceleration.
 struct GravityObservation {
   size_t node = 0;
   Eigen::Vector3d mean_force = Eigen::Vector3d::Zero();
   Eigen::Matrix3d bias_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d velocity_change = Eigen::Vector3d::Zero();
+  /// The odometry's acceleration over the window, weighted as mean_force is.
+  Eigen::Vector3d path_acceleration = Eigen::Vector3d::Zero();
   double sigma_rad = 1.0;  ///< the direction's standard deviation per axis, radians
   size_t samples = 0;
 
   /// Up in the keyframe's frame for bias `bias` (not normalised).
   Eigen::Vector3d up(const Eigen::Vector3d& bias = Eigen::Vector3d::Zero()) const {
-    return mean_force - bias_rotation * bias - velocity_change;
+    return mean_force - bias_rotation * bias - path_acceleration;
   }
 };
 
