@@ -5,6 +5,11 @@
 #include "featsense/bench/measurements.hpp"
 
 namespace featsense::app {
+namespace {
+
+constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+}  // namespace
 
 using bench::summarize_ms;
 using bench::timing_json;
@@ -104,6 +109,17 @@ nlohmann::json loops_json(const mapping::LoopOutcome& outcome, double finish_ms)
     gravity_json["levelled_deg"] = gravity.levelled_deg;
     gravity_json["rms_whitened"] = gravity.rms_whitened;
   }
+  const slam::loops::PoseGraphSummary& last = outcome.final_optimisation;
+  nlohmann::json gyro_json = {{"edges", last.gyro_edges},
+                              {"consistent_with_lidar", last.turn_agreement.consistent}};
+  if (last.turn_agreement.edges > 0) {
+    const auto triple = [](const Eigen::Vector3d& v) {
+      return nlohmann::json::array({v.x(), v.y(), v.z()});
+    };
+    gyro_json["bias_radps"] = triple(last.gyro_bias_radps);
+    gyro_json["disagreement_deg"] = triple(last.turn_agreement.disagreement_rad * kDegrees);
+    gyro_json["lidar_sigma_deg"] = triple(last.turn_agreement.lidar_sigma_rad * kDegrees);
+  }
   return {{"keyframes", counts.keyframes},
           {"candidates", counts.candidates},
           {"verified", counts.verified},
@@ -114,6 +130,7 @@ nlohmann::json loops_json(const mapping::LoopOutcome& outcome, double finish_ms)
           {"keyframe_clouds_mb", static_cast<double>(counts.cloud_bytes) / 1e6},
           {"loops", list},
           {"gravity", gravity_json},
+          {"gyro", gyro_json},
           {"timings",
            {{"keyframe", timing_json(counts.keyframe_ms)},
             {"optimise", timing_json(counts.optimise_ms)},

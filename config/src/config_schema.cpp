@@ -324,6 +324,7 @@ std::vector<KeySpec> make_specs() {
       number_key("loop.drift", &Config::loop, &LoopConfig::drift, {0.0, 1.0}),
       bool_key("loop.gravity", &Config::loop, &LoopConfig::gravity),
       number_key("loop.gravity_window", &Config::loop, &LoopConfig::gravity_window_s, {0.5, 60.0}),
+      bool_key("loop.gyro", &Config::loop, &LoopConfig::gyro),
       integer_key("relocalize.max_scans", &Config::relocalize, &RelocalizeConfig::max_scans, 1,
                   1000000),
       integer_key("relocalize.confirmations", &Config::relocalize, &RelocalizeConfig::confirmations,

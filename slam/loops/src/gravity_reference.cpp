@@ -127,6 +127,15 @@ class QuadraticFitKernel {
 
 }  // namespace
 
+int64_t median_sample_period_ns(const std::vector<ImuSample>& samples) {
+  if (samples.size() < 2) return 0;
+  std::vector<int64_t> spacing;
+  for (size_t i = 1; i < samples.size(); ++i)
+    spacing.push_back(samples[i].stamp_ns - samples[i - 1].stamp_ns);
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  return spacing[spacing.size() / 2];
+}
+
 void append_in_time_order(std::vector<ImuSample>* log, const std::vector<ImuSample>& more) {
   for (const ImuSample& sample : more) {
     if (log->empty() || sample.stamp_ns > log->back().stamp_ns) log->push_back(sample);
@@ -142,12 +151,7 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
   if (!settings.enabled || samples.size() < 2 || path.size() < 2 ||
       path_stamps_ns.size() != path.size())
     return out;
-  // The IMU's sample period, from the median spacing (robust to a gap).
-  std::vector<int64_t> spacing;
-  for (size_t i = 1; i < samples.size(); ++i)
-    spacing.push_back(samples[i].stamp_ns - samples[i - 1].stamp_ns);
-  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  const int64_t period_ns = spacing[spacing.size() / 2];
+  const int64_t period_ns = median_sample_period_ns(samples);
   if (period_ns <= 0) return out;
   const auto window_ns = static_cast<int64_t>(settings.window_s * 1e9);
   const auto wanted = static_cast<size_t>(settings.window_s / seconds(period_ns));

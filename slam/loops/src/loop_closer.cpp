@@ -81,6 +81,7 @@ LoopSettings from_config(const config::Config& config) {
   settings.drift_per_m = config.loop.drift;
   settings.gravity.enabled = config.loop.gravity;
   settings.gravity.window_s = config.loop.gravity_window_s;
+  settings.gyro.enabled = config.loop.gyro;
   return settings;
 }
 
@@ -372,8 +373,39 @@ PoseGraphSummary LoopCloser::finish(const std::vector<int64_t>& path_stamps_ns,
       gravity_observations(path_stamps_ns, path, samples, keyframe_stamps_ns, settings_.gravity);
   for (const GravityObservation& observation : observations)
     graph_.add_gravity(observation, settings_.gravity.bias_prior_mps2);
-  if (loops_.empty() && observations.empty()) return {};
-  return optimise_timed();
+  std::vector<GyroObservation> turns =
+      gyro_observations(samples, keyframe_stamps_ns, settings_.gyro);
+  const TurnAgreement agreement = weigh_against_lidar(&turns, lidar_turns(&turns));
+  if (!agreement.consistent) turns.clear();
+  for (const GyroObservation& turn : turns) graph_.add_gyro(turn, settings_.gyro.bias_prior_radps);
+  if (loops_.empty() && observations.empty() && turns.empty()) return {};
+  PoseGraphSummary summary = optimise_timed();
+  summary.turn_agreement = agreement;
+  return summary;
+}
+
+std::vector<LidarTurn> LoopCloser::lidar_turns(std::vector<GyroObservation>* turns) const {
+  // The odometry edge between each pair of consecutive keyframes (edge k - 1 joins k - 1 and
+  // k), its rotation and the sigma of its rotation's block. A turn without one (between two
+  // sessions of a continued map) is dropped: nothing tells how the gyroscope compares there.
+  std::vector<const PoseGraphEdge*> odometry_into(graph_.size(), nullptr);
+  for (const PoseGraphEdge& edge : graph_.edges())
+    if (!edge.loop && edge.to == edge.from + 1) odometry_into[edge.to] = &edge;
+  std::vector<LidarTurn> out;
+  std::vector<GyroObservation> kept;
+  for (const GyroObservation& turn : *turns) {
+    const PoseGraphEdge* odometry =
+        turn.to < odometry_into.size() ? odometry_into[turn.to] : nullptr;
+    if (odometry == nullptr || turn.from + 1 != turn.to) continue;
+    LidarTurn lidar;
+    lidar.rotation = odometry->T_from_to.rotation();
+    const Matrix6d covariance = odometry->information.inverse();
+    lidar.sigma_rad = covariance.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+    out.push_back(lidar);
+    kept.push_back(turn);
+  }
+  *turns = std::move(kept);
+  return out;
 }
 
 TrajectoryCorrection LoopCloser::correction() const {

@@ -116,6 +116,53 @@ class BiasPriorCost {
   double sigma_;
 };
 
+/// A gyroscope edge's error: the rotation the graph has between its nodes against the
+/// gyroscope's, its bias taken out (delta Exp(-J b)), as an angle-axis over sigma.
+class GyroCost {
+ public:
+  explicit GyroCost(const GyroObservation& observation)
+      : delta_(Eigen::Quaterniond(observation.delta).normalized()),
+        jacobian_(observation.bias_jacobian),
+        sigma_(observation.sigma_rad) {}
+
+  template <typename T>
+  bool operator()(const T* q_from, const T* q_to, const T* bias, T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Eigen::Quaternion<T>> r_from(q_from);
+    const Eigen::Map<const Eigen::Quaternion<T>> r_to(q_to);
+    const Vector3 correction = -(jacobian_.template cast<T>() * Eigen::Map<const Vector3>(bias));
+    T correction_wxyz[4];
+    ceres::AngleAxisToQuaternion(correction.data(), correction_wxyz);
+    const Eigen::Quaternion<T> r_correction(correction_wxyz[0], correction_wxyz[1],
+                                            correction_wxyz[2], correction_wxyz[3]);
+    const Eigen::Quaternion<T> measured = delta_.template cast<T>() * r_correction;
+    const Eigen::Quaternion<T> error = measured.conjugate() * (r_from.conjugate() * r_to);
+    const T wxyz[4] = {error.w(), error.x(), error.y(), error.z()};
+    ceres::QuaternionToAngleAxis(wxyz, residual);
+    for (int i = 0; i < 3; ++i) residual[i] /= T(sigma_(i));
+    return true;
+  }
+
+ private:
+  Eigen::Quaterniond delta_;
+  Eigen::Matrix3d jacobian_;
+  Eigen::Vector3d sigma_;
+};
+
+/// A weak prior on the gyroscope's bias (zero), rad/s.
+class GyroBiasPriorCost {
+ public:
+  explicit GyroBiasPriorCost(double sigma) : sigma_(sigma) {}
+  template <typename T>
+  bool operator()(const T* bias, T* residual) const {
+    for (int i = 0; i < 3; ++i) residual[i] = bias[i] / sigma_;
+    return true;
+  }
+
+ private:
+  double sigma_;
+};
+
 constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
 
 /// What the gravity observations say at the solution, in one pass over them: the covariance
@@ -241,6 +288,20 @@ void PoseGraph::add_gravity(const GravityObservation& observation, double bias_p
   bias_prior_mps2_ = bias_prior_mps2;
 }
 
+void PoseGraph::add_gyro(const GyroObservation& observation, double bias_prior_radps) {
+  if (observation.from >= poses_.size() || observation.to >= poses_.size() ||
+      observation.from == observation.to)
+    throw std::invalid_argument(
+        "pose graph: a gyroscope edge between nodes " + std::to_string(observation.from) + " and " +
+        std::to_string(observation.to) + " of " + std::to_string(poses_.size()));
+  if (!(observation.sigma_rad.minCoeff() > 0.0) || !observation.sigma_rad.allFinite() ||
+      !(bias_prior_radps > 0.0) || !observation.delta.allFinite() ||
+      !observation.bias_jacobian.allFinite())
+    throw std::invalid_argument("pose graph: a gyroscope edge without a rotation or sigma");
+  gyro_.push_back(observation);
+  gyro_bias_prior_radps_ = bias_prior_radps;
+}
+
 double PoseGraph::whitened_error(const PoseGraphEdge& edge) const {
   const Eigen::Matrix<double, 6, 1> e =
       edge_error(poses_[edge.from], poses_[edge.to], edge.T_from_to);
@@ -301,6 +362,18 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
         new ceres::AutoDiffCostFunction<BiasPriorCost, 2, 2>(new BiasPriorCost(bias_prior_mps2_)),
         nullptr, bias_coordinates.data());
   }
+  for (const GyroObservation& observation : gyro_) {
+    // Huber: an edge over a jolt or a clock's jump pulls, but only so far.
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<GyroCost, 3, 4, 4, 3>(new GyroCost(observation)),
+        new ceres::HuberLoss(3.0), rotations[observation.from].coeffs().data(),
+        rotations[observation.to].coeffs().data(), gyro_bias_.data());
+  }
+  if (!gyro_.empty()) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GyroBiasPriorCost, 3, 3>(
+                                 new GyroBiasPriorCost(gyro_bias_prior_radps_)),
+                             nullptr, gyro_bias_.data());
+  }
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -327,6 +400,8 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
     for (ceres::LossFunctionWrapper* loss : loop_losses)
       loss->Reset(new ceres::CauchyLoss(scale), ceres::TAKE_OWNERSHIP);
   }
+  summary.gyro_edges = gyro_.size();
+  summary.gyro_bias_radps = gyro_bias_;
   // With gravity, the poses go into the vertical frame: the map frame tilted back by what the
   // observations of every node say (the first node alone, held fixed, would decide it else).
   Eigen::Isometry3d level = Eigen::Isometry3d::Identity();

@@ -131,6 +131,7 @@ void Mapper::second_pass(MapResult& result) {
   const LoopOutcome& loops = *result.first.loops;
   events_.info(std::to_string(loops.loops.size()) + " loops closed" +
                (loops.gravity.observations > 0 ? ", levelled by gravity" : "") +
+               (loops.final_optimisation.gyro_edges > 0 ? ", turns held by the gyroscope" : "") +
                ": mapping the recording again with the corrected poses");
   const config::Config& config = settings_.config;
   const fs::path replay_path = beside(settings_.map_path, "corrected");

@@ -127,6 +127,7 @@ struct LoopConfig {
   double drift = 0.02;
   bool gravity = true;
   double gravity_window_s = 4.0;
+  bool gyro = true;
 };
 
 struct RelocalizeConfig {

@@ -40,9 +40,11 @@ struct LoopOutcome {
   std::optional<slam::loops::Relocalization> relocalization;
   slam::loops::RelocalizationCounts relocalize_counts;
   bool relocalize_gave_up = false;
-  /// Whether the corrected poses differ from those the map was made with: loops were closed
-  /// or gravity levelled the path.
-  bool corrects_poses() const { return !loops.empty() || gravity.observations > 0; }
+  /// Whether the corrected poses differ from those the map was made with: loops were closed,
+  /// gravity levelled the path or the gyroscope held its turns.
+  bool corrects_poses() const {
+    return !loops.empty() || gravity.observations > 0 || final_optimisation.gyro_edges > 0;
+  }
 };
 
 /// Every pose of `path` (pose i taken `travelled_m[i]` metres along it) moved by the

@@ -54,6 +54,10 @@ struct GravityObservation {
   }
 };
 
+/// The IMU's sample period from the median spacing of `samples` (at least two, time order):
+/// robust to a gap or a late sample.
+int64_t median_sample_period_ns(const std::vector<ImuSample>& samples);
+
 /// Appends `more` to `log`, keeping time order: a sample not after the last one is dropped.
 void append_in_time_order(std::vector<ImuSample>* log, const std::vector<ImuSample>& more);
 

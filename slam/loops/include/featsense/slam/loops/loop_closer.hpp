@@ -95,6 +95,8 @@ struct LoopSettings {
   PoseGraphSettings graph;
   /// The IMU's gravity as the graph's vertical reference (gravity_reference.hpp).
   GravitySettings gravity;
+  /// The IMU's gyroscope between keyframes (gyro_reference.hpp).
+  GyroSettings gyro;
 };
 
 /// loop.* of `config`.
@@ -188,10 +190,11 @@ class LoopCloser {
                      const Matrix6d& information);
 
   /// The end of a run: the gravity the IMU's `samples` (time order) saw around each keyframe,
-  /// with the rotations and velocities of the front end's `path` (every scan's stamp and pose,
+  /// with the rotations and positions of the front end's `path` (every scan's stamp and pose,
   /// stamps increasing), goes into the graph (none without samples or with loop.gravity off),
-  /// and the graph is optimised once more where it holds loops or gravity. Its summary, empty
-  /// where nothing was optimised.
+  /// and so does the gyroscope's turn between keyframes, weighed against the LiDAR's (none
+  /// with loop.gyro off); the graph is optimised once more where it holds any of them. Its summary,
+  /// empty where nothing was optimised.
   PoseGraphSummary finish(const std::vector<int64_t>& path_stamps_ns,
                           const std::vector<Eigen::Isometry3d>& path,
                           const std::vector<ImuSample>& samples);
@@ -229,6 +232,9 @@ class LoopCloser {
   refine::GaussianCloud target_around(size_t keyframe) const;
   void add_odometry_edge(size_t keyframe, const refine::GaussianCloud& cloud);
   PoseGraphSummary optimise_timed();
+  /// The odometry edges' turns under `turns` (consecutive keyframes), in order; a turn
+  /// without one is dropped from `turns`.
+  std::vector<LidarTurn> lidar_turns(std::vector<GyroObservation>* turns) const;
 
   LoopSettings settings_;
   std::vector<Keyframe> keyframes_;

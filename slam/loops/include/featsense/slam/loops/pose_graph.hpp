@@ -10,6 +10,8 @@
 /// then turned towards the vertical frame (Z up, the first node's position and heading kept)
 /// by as much of that tilt as gravity is sure of: the map is level with gravity, whatever the
 /// first scan's tilt, once the path has turned enough to tell the bias from a tilt.
+/// Where the IMU's gyroscope turned between two nodes (gyro_reference.hpp), an edge ties their
+/// relative rotation to its turn, less its bias (one more variable).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "featsense/slam/loops/gravity_reference.hpp"
+#include "featsense/slam/loops/gyro_reference.hpp"
 
 namespace featsense::slam::loops {
 
@@ -73,6 +76,11 @@ struct PoseGraphSummary {
   std::vector<double> loop_chi;
   std::vector<double> loop_weights;
   GravityEstimate gravity;
+  /// The gyroscope's edges and the bias found for it, rad/s (zero without edges).
+  size_t gyro_edges = 0;
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
+  /// How the gyroscope's turns and the LiDAR's agreed (filled by LoopCloser::finish).
+  TurnAgreement turn_agreement;
 };
 
 class PoseGraph {
@@ -84,6 +92,9 @@ class PoseGraph {
   void add_edge(const PoseGraphEdge& edge);
   /// Throws std::invalid_argument for a node out of range or a sigma that is not positive.
   void add_gravity(const GravityObservation& observation, double bias_prior_mps2);
+  /// Throws std::invalid_argument for a node out of range, a self edge or a sigma that is not
+  /// positive.
+  void add_gyro(const GyroObservation& observation, double bias_prior_radps);
   PoseGraphSummary optimize(const PoseGraphSettings& settings = {});
 
   size_t size() const { return poses_.size(); }
@@ -102,6 +113,9 @@ class PoseGraph {
   /// The map frame's tilt (angle-axis about x and y) and the bias, kept between solves.
   Eigen::Vector2d map_tilt_rad_ = Eigen::Vector2d::Zero();
   Eigen::Vector3d accel_bias_ = Eigen::Vector3d::Zero();
+  std::vector<GyroObservation> gyro_;
+  double gyro_bias_prior_radps_ = 0.02;
+  Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero();
 };
 
 /// The error of an edge measured as T_from_to between poses at `T_map_from` and `T_map_to`, in
