@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <vector>
 
 #include "featsense/slam/loops/gravity_reference.hpp"
+#include "featsense/slam/trajectory/gyro_rotation.hpp"
 
 namespace featsense::slam::loops {
 namespace {
@@ -24,19 +26,6 @@ constexpr double kLidarFloorShare = 0.1;
 /// A disagreement beyond this many times what the two claim together is not noise.
 constexpr double kInconsistent = 5.0;
 
-Eigen::Matrix3d exp_map(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (angle < 1e-15) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-}
-
-/// The rate at `t_ns` between two samples, linear (a sample is a reading at its instant).
-Eigen::Vector3d rate_at(const ImuSample& a, const ImuSample& b, int64_t t_ns) {
-  const double f =
-      static_cast<double>(t_ns - a.stamp_ns) / static_cast<double>(b.stamp_ns - a.stamp_ns);
-  return (1.0 - f) * a.gyro_radps + f * b.gyro_radps;
-}
-
 }  // namespace
 
 std::vector<GyroObservation> gyro_observations(const std::vector<ImuSample>& samples,
@@ -46,7 +35,7 @@ std::vector<GyroObservation> gyro_observations(const std::vector<ImuSample>& sam
   if (!settings.enabled || samples.size() < 2 || keyframe_stamps_ns.size() < 2) return out;
   const int64_t period_ns = median_sample_period_ns(samples);
   if (period_ns <= 0) return out;
-  const auto max_gap_ns = static_cast<int64_t>(settings.max_gap_periods * period_ns);
+  const double max_gap_s = settings.max_gap_periods * seconds(period_ns);
   const auto by_stamp = [](const ImuSample& s, int64_t t) { return s.stamp_ns < t; };
 
   for (size_t k = 1; k < keyframe_stamps_ns.size(); ++k) {
@@ -61,30 +50,15 @@ std::vector<GyroObservation> gyro_observations(const std::vector<ImuSample>& sam
     }
     auto last = std::lower_bound(first, samples.end(), t1, by_stamp);
     if (last == samples.end()) continue;
+    // The chain of the samples over [t0, t1] (gyro_rotation's), with its bias Jacobian.
+    const std::vector<ImuSample> span_samples(first, std::next(last));
+    const std::optional<GyroTurn> chained = gyro_turn(span_samples, {}, t0, t1, max_gap_s);
+    if (!chained) continue;
     GyroObservation o;
     o.from = k - 1;
     o.to = k;
-    bool gap = false;
-    // Each piece between two samples, clipped to [t0, t1], turns by its mean rate (the
-    // trapezoid of the linear rate) times its length; the chain's bias Jacobian follows
-    // J <- E^T J + dt I (the step's right Jacobian taken as I: steps of a hundredth of a
-    // radian).
-    for (auto s = first; s != last; ++s) {
-      const auto next = std::next(s);
-      if (next->stamp_ns - s->stamp_ns > max_gap_ns || next->stamp_ns <= s->stamp_ns) {
-        gap = true;
-        break;
-      }
-      const int64_t from = std::max(s->stamp_ns, t0), to = std::min(next->stamp_ns, t1);
-      if (to <= from) continue;
-      const Eigen::Vector3d rate = 0.5 * (rate_at(*s, *next, from) + rate_at(*s, *next, to));
-      const double dt = seconds(to - from);
-      const Eigen::Matrix3d step = exp_map(rate * dt);
-      o.delta = o.delta * step;
-      o.bias_jacobian = step.transpose() * o.bias_jacobian + dt * Eigen::Matrix3d::Identity();
-      ++o.samples;
-    }
-    if (gap || o.samples == 0) continue;
+    o.delta = chained->rotation;
+    o.bias_jacobian = chained->bias_jacobian;
     const double span = seconds(t1 - t0);
     const double turn = Eigen::AngleAxisd(o.delta).angle();
     const Eigen::Vector3d rate_change =

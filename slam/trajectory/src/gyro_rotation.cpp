@@ -26,9 +26,17 @@ std::optional<Eigen::Matrix3d> gyro_rotation(const std::vector<ImuSample>& earli
                                              const std::vector<ImuSample>& later, int64_t from_ns,
                                              int64_t to_ns) {
   const double period_s = static_cast<double>(to_ns - from_ns) * 1e-9;
+  const std::optional<GyroTurn> turn = gyro_turn(earlier, later, from_ns, to_ns, 0.5 * period_s);
+  if (!turn) return std::nullopt;
+  return turn->rotation;
+}
+
+std::optional<GyroTurn> gyro_turn(const std::vector<ImuSample>& earlier,
+                                  const std::vector<ImuSample>& later, int64_t from_ns,
+                                  int64_t to_ns, double max_gap_s) {
+  const double period_s = static_cast<double>(to_ns - from_ns) * 1e-9;
   if (!(period_s > 0.0)) return std::nullopt;
   const gyro::Rates samples = gyro::merged_rates(earlier, later, from_ns);
-  const double max_gap_s = 0.5 * period_s;
   const std::vector<double>& times = samples.times_s;
   if (times.size() < 2 || times.front() > max_gap_s || times.back() < period_s - max_gap_s) {
     return std::nullopt;
@@ -39,16 +47,21 @@ std::optional<Eigen::Matrix3d> gyro_rotation(const std::vector<ImuSample>& earli
     if (t > 0.0 && t < period_s) knots.push_back(t);
   }
   knots.push_back(period_s);
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  GyroTurn turn;
   for (size_t k = 1; k < knots.size(); ++k) {
     const double dt = knots[k] - knots[k - 1];
     if (dt > max_gap_s) return std::nullopt;
     // The midpoint rule on a linear rate is exact for the rate's integral.
     const Eigen::Vector3d mean_rate =
         0.5 * (rate_at(samples, knots[k - 1]) + rate_at(samples, knots[k]));
-    rotation = rotation * gyro::rotation_of(mean_rate * dt);
+    const Eigen::Matrix3d step = gyro::rotation_of(mean_rate * dt);
+    turn.rotation = turn.rotation * step;
+    // A bias b turns each step by Exp(-b dt); moved past the later steps, the chain's
+    // Jacobian follows J <- E^T J + dt I (the step's right Jacobian taken as I: steps of a
+    // hundredth of a radian).
+    turn.bias_jacobian = step.transpose() * turn.bias_jacobian + dt * Eigen::Matrix3d::Identity();
   }
-  return rotation;
+  return turn;
 }
 
 Eigen::Isometry3d gyro_corrected_prediction(const Eigen::Isometry3d& predicted,

@@ -47,7 +47,6 @@ struct GyroObservation {
   Eigen::Vector3d sigma_rad = Eigen::Vector3d::Ones();
   /// The white noise and floor alone, radians (what the gyroscope errs by on any mounting).
   double noise_rad = 1.0;
-  size_t samples = 0;
 };
 
 /// The LiDAR's turn between the same two keyframes (the odometry edge's), and the standard

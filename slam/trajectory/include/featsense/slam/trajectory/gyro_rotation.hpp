@@ -28,6 +28,20 @@ std::optional<Eigen::Matrix3d> gyro_rotation(const std::vector<ImuSample>& earli
                                              const std::vector<ImuSample>& later, int64_t from_ns,
                                              int64_t to_ns);
 
+/// A turn the gyroscope measured, and how it moves with a constant bias b of the rates: the
+/// turn with the bias taken out is rotation Exp(-bias_jacobian b), to first order.
+struct GyroTurn {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d bias_jacobian = Eigen::Matrix3d::Zero();
+};
+
+/// gyro_rotation's turn with its bias Jacobian, and a gap allowed of `max_gap_s` seconds
+/// (gyro_rotation allows half the period): empty where the period is not positive or the
+/// samples leave a longer gap anywhere over it (the ends included).
+std::optional<GyroTurn> gyro_turn(const std::vector<ImuSample>& earlier,
+                                  const std::vector<ImuSample>& later, int64_t from_ns,
+                                  int64_t to_ns, double max_gap_s);
+
 /// The constant-velocity prediction `predicted` (last_motion scaled to this period) with its
 /// rotation replaced by the gyroscope's turn over this period `turn_now`, corrected by the
 /// LiDAR's: the gyroscope's error over the last period (`turn_before` against
