@@ -1,5 +1,7 @@
 #include "featsense/slam/loops/gravity_reference.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -66,11 +68,11 @@ class QuadraticFitKernel {
       const double t = seconds(stamps_[j] - middle);
       design.row(static_cast<Eigen::Index>(j)) << 1.0, t, 0.5 * t * t;
     }
-    // The third row of the pseudo-inverse, from a QR solve (centred times: well conditioned).
-    const Eigen::MatrixXd pseudo_inverse = design.colPivHouseholderQr().solve(
-        Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n)));
-    weights_.resize(n);
-    for (size_t j = 0; j < n; ++j) weights_[j] = pseudo_inverse(2, static_cast<Eigen::Index>(j));
+    // The third row of the pseudo-inverse, A (A^T A)^-1 e_3 (centred times: well conditioned).
+    const Eigen::Vector3d row =
+        (design.transpose() * design).ldlt().solve(Eigen::Vector3d::UnitZ());
+    const Eigen::VectorXd weights = design * row;
+    weights_.assign(weights.data(), weights.data() + weights.size());
     // K at each stamp: sum over the later stamps of w_j (t_j - t_m).
     at_stamps_.assign(n, 0.0);
     for (size_t m = 0; m < n; ++m)
