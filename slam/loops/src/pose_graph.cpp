@@ -101,14 +101,16 @@ class GravityCost {
   double length_;
 };
 
-/// A weak prior on the accelerometer's bias, for paths that never turn (it is unobservable
-/// from a tilt of the whole map then).
+/// A weak prior, zero with `sigma` per component, on a bias of `Size` components: the
+/// accelerometer's (for paths that never turn, it is unobservable from a tilt of the whole
+/// map then) and the gyroscope's.
+template <int Size>
 class BiasPriorCost {
  public:
   explicit BiasPriorCost(double sigma) : sigma_(sigma) {}
   template <typename T>
   bool operator()(const T* bias, T* residual) const {
-    for (int i = 0; i < 2; ++i) residual[i] = bias[i] / sigma_;
+    for (int i = 0; i < Size; ++i) residual[i] = bias[i] / sigma_;
     return true;
   }
 
@@ -147,20 +149,6 @@ class GyroCost {
   Eigen::Quaterniond delta_;
   Eigen::Matrix3d jacobian_;
   Eigen::Vector3d sigma_;
-};
-
-/// A weak prior on the gyroscope's bias (zero), rad/s.
-class GyroBiasPriorCost {
- public:
-  explicit GyroBiasPriorCost(double sigma) : sigma_(sigma) {}
-  template <typename T>
-  bool operator()(const T* bias, T* residual) const {
-    for (int i = 0; i < 3; ++i) residual[i] = bias[i] / sigma_;
-    return true;
-  }
-
- private:
-  double sigma_;
 };
 
 constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
@@ -358,9 +346,9 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
                              map_tilt_rad_.data(), bias_coordinates.data());
   }
   if (!gravity_.empty()) {
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<BiasPriorCost, 2, 2>(new BiasPriorCost(bias_prior_mps2_)),
-        nullptr, bias_coordinates.data());
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPriorCost<2>, 2, 2>(
+                                 new BiasPriorCost<2>(bias_prior_mps2_)),
+                             nullptr, bias_coordinates.data());
   }
   for (const GyroObservation& observation : gyro_) {
     // Huber: an edge over a jolt or a clock's jump pulls, but only so far.
@@ -370,8 +358,8 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphSettings& settings) {
         rotations[observation.to].coeffs().data(), gyro_bias_.data());
   }
   if (!gyro_.empty()) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<GyroBiasPriorCost, 3, 3>(
-                                 new GyroBiasPriorCost(gyro_bias_prior_radps_)),
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPriorCost<3>, 3, 3>(
+                                 new BiasPriorCost<3>(gyro_bias_prior_radps_)),
                              nullptr, gyro_bias_.data());
   }
 
