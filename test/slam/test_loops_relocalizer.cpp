@@ -156,6 +156,53 @@ TEST(Relocalizer, AVerifierChecksTheCandidatesInPlaceOfTheMapKeyframes) {
   EXPECT_EQ(refuses.counts().rejected.at("no surface"), refuses.counts().candidates);
 }
 
+TEST(Relocalizer, AnAmbiguousKeyframeIsConfirmedByTheNextOneThatIsNot) {
+  // The first keyframe fits the truth and, nearly as well, a place 8 m along the lane (a
+  // block like another one); the second fits the truth alone. The first's places stay
+  // hypotheses: the second picks the true one and, with it, makes two keyframes that agree.
+  const mesh::TriangleMesh scene = build_scene("parking");
+  const std::vector<Eigen::Isometry3d> truth = eastbound(20.0, 40.0);
+  size_t k = 0;
+  bool both_ambiguous = false;
+  const PlaceVerifier twin_at_first = [&](const Eigen::Isometry3d& guess,
+                                          const refine::GaussianCloud&) {
+    PlaceCheck check;
+    if ((guess.translation() - truth[k].translation()).norm() <= 3.0) {
+      check.T_map_query = truth[k];
+      check.inlier_fraction = 0.8;
+    } else if (k == 0 || both_ambiguous) {
+      check.T_map_query = pose(0.0, 0.0, 0.0, {8.0, 0.0, 0.0}) * truth[k];
+      check.inlier_fraction = 0.75;
+    } else {
+      check.rejection = "elsewhere";
+    }
+    return check;
+  };
+  const auto run = [&](Relocalizer& relocalizer, size_t keyframes) {
+    std::optional<Relocalization> placed;
+    for (k = 0; k < keyframes && !placed; ++k) {
+      placed = relocalizer.add_keyframe(
+          static_cast<int64_t>(k) * 400'000'000, truth.front().inverse() * truth[k], 2.0 * k,
+          test::keyframe_scan_at(scene, truth[k], static_cast<uint32_t>(k)));
+    }
+    return placed;
+  };
+  Relocalizer relocalizer(lane_map(scene, 0, eastbound(6.0, 58.0)), RelocalizeSettings{},
+                          twin_at_first);
+  const std::optional<Relocalization> placed = run(relocalizer, truth.size());
+  ASSERT_TRUE(placed);
+  EXPECT_EQ(placed->keyframe, 1u);
+  EXPECT_EQ(placed->agreeing, 2u);
+  EXPECT_GT(relocalizer.counts().rejected.at("ambiguous"), 0u);
+  EXPECT_LT((placed->T_map_session.translation() - truth.front().translation()).norm(), 1e-9);
+
+  // Where every keyframe is ambiguous, none places the session, however many agree.
+  both_ambiguous = true;
+  Relocalizer twins(lane_map(scene, 0, eastbound(6.0, 58.0)), RelocalizeSettings{}, twin_at_first);
+  EXPECT_FALSE(run(twins, truth.size()));
+  EXPECT_EQ(twins.counts().keyframes, truth.size());
+}
+
 TEST(SessionLinks, ALaterSessionPlacedOffIsPulledOntoTheFirst) {
   const mesh::TriangleMesh scene = build_scene("parking");
   std::vector<MapKeyframe> keyframes = lane_map(scene, 0, eastbound(6.0, 58.0));

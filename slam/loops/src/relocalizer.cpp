@@ -131,6 +131,22 @@ bool Relocalizer::agree(const Hypothesis& a, const Hypothesis& b) const {
              tolerance_deg;
 }
 
+std::pair<size_t, size_t> Relocalizer::earlier_keyframes_agreeing(
+    const Hypothesis& hypothesis) const {
+  // Hypotheses are in keyframe order: one run of them per earlier keyframe.
+  size_t agreeing = 1;
+  size_t disagreeing = 0;
+  for (size_t i = 0; i < hypotheses_.size();) {
+    size_t end = i;
+    bool agrees = false;
+    for (; end < hypotheses_.size() && hypotheses_[end].keyframe == hypotheses_[i].keyframe; ++end)
+      agrees = agrees || agree(hypotheses_[end], hypothesis);
+    (agrees ? agreeing : disagreeing)++;
+    i = end;
+  }
+  return {agreeing, disagreeing};
+}
+
 std::optional<Relocalization> Relocalizer::add_keyframe(
     int64_t stamp_ns, const Eigen::Isometry3d& T_session_sensor, double travelled_m,
     const std::vector<Eigen::Vector3f>& points) {
@@ -205,20 +221,23 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
       *std::max_element(verified.begin(), verified.end(), [](const Verified& a, const Verified& b) {
         return a.result.inlier_fraction < b.result.inlier_fraction;
       });
-  for (const Verified& rival : verified) {
-    if ((rival.T_map_query.translation() - best.T_map_query.translation()).norm() >
-            loop.ambiguity_m &&
-        rival.result.inlier_fraction >= kRivalInlierRatio * best.result.inlier_fraction) {
-      counts_.rejected["ambiguous"] += verified.size();
-      done();
-      return std::nullopt;
-    }
+  const auto session_at = [&](const Verified& v) {
+    return Hypothesis{keyframe, travelled_m, v.T_map_query * T_session_sensor.inverse()};
+  };
+  const bool ambiguous = std::any_of(verified.begin(), verified.end(), [&](const Verified& rival) {
+    return (rival.T_map_query.translation() - best.T_map_query.translation()).norm() >
+               loop.ambiguity_m &&
+           rival.result.inlier_fraction >= kRivalInlierRatio * best.result.inlier_fraction;
+  });
+  if (ambiguous) {
+    // Each of its places stays a hypothesis that a later, unambiguous keyframe may pick.
+    counts_.rejected["ambiguous"] += verified.size();
+    for (const Verified& v : verified) hypotheses_.push_back(session_at(v));
+    done();
+    return std::nullopt;
   }
-  const Hypothesis hypothesis{keyframe, travelled_m, best.T_map_query * T_session_sensor.inverse()};
-  size_t agreeing = 1;
-  size_t disagreeing = 0;
-  for (const Hypothesis& earlier : hypotheses_)
-    (agree(earlier, hypothesis) ? agreeing : disagreeing)++;
+  const Hypothesis hypothesis = session_at(best);
+  const auto [agreeing, disagreeing] = earlier_keyframes_agreeing(hypothesis);
   hypotheses_.push_back(hypothesis);
   // Confirmed by enough keyframes, and by more than any other place was.
   if (agreeing >= settings_.confirmations && agreeing > disagreeing) {

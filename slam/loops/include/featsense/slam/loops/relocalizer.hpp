@@ -4,8 +4,9 @@
 /// keyframes as a loop would be (ring keys, then the full Scan Context match with its yaw),
 /// and the best few candidates at distinct places are verified by voxelized GICP. A keyframe
 /// whose verified candidates put it at two places is ambiguous (a block like another one) and
-/// places nothing. Each unambiguous match says where the session's frame lies in the map;
-/// the session is placed once `confirmations` keyframes agree on it (a single good-looking
+/// places nothing by itself; a later unambiguous keyframe may pick one of its places. Each
+/// unambiguous match says where the session's frame lies in the map; the session is placed
+/// once `confirmations` keyframes agree on it (a single good-looking
 /// fit is a guess, and the map is never merged on a guess). A user's guess of the session's
 /// frame adds the map keyframes around it as candidates; it is verified like any other. A
 /// match also guesses where the next keyframes lie: each is tried there too, so that a place
@@ -20,6 +21,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "featsense/config/config.hpp"
@@ -119,6 +121,9 @@ class Relocalizer {
   std::vector<Candidate> candidates(const ScanContext& descriptor,
                                     const Eigen::Isometry3d& T_session_sensor) const;
   bool agree(const Hypothesis& a, const Hypothesis& b) const;
+  /// Earlier keyframes with a place that agrees with `hypothesis` (plus its own: 1 at least),
+  /// and those without one. An ambiguous keyframe counts once, with any of its places.
+  std::pair<size_t, size_t> earlier_keyframes_agreeing(const Hypothesis& hypothesis) const;
 
   std::vector<MapKeyframe> map_;
   std::vector<Eigen::Isometry3d> map_poses_;
