@@ -1,5 +1,6 @@
 #include "featsense/mapping/localizer.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "map_surface.hpp"
 #include "map_targets.hpp"
+#include "place_correlation.hpp"
 #include "timed_scan_cloud.hpp"
 
 namespace featsense::mapping {
@@ -80,6 +82,8 @@ std::string metres_text(double m) {
 
 /// Too few points to say anything: neither a fit nor a contradiction.
 constexpr size_t kMinPoints = 30;
+/// A surface is upright (a wall, a post) where its normal's vertical part is at most this.
+constexpr double kUprightMaxNormalZ = 0.5;
 
 struct Localizer::State {
   State(const std::filesystem::path& map, const config::Config& config_in,
@@ -152,7 +156,8 @@ struct Localizer::State {
     const Eigen::Vector3d centre((key[0] + 0.5) * cell_m, (key[1] + 0.5) * cell_m, position.z());
     std::shared_ptr<const MapTarget> target = build_map_target(
         surface, centre, settings.search_radius_m + cell_m, settings.search_voxel_sizes_m,
-        settings.vgicp.fitness_voxel_m, settings.vgicp.fitness_voxel_m);
+        settings.vgicp.fitness_voxel_m, settings.vgicp.fitness_voxel_m,
+        settings.search_reach_m > 0.0 ? kUprightMaxNormalZ : -1.0);
     search_targets.emplace_front(key, target);
     if (search_targets.size() > settings.search_targets_kept) search_targets.pop_back();
     return target;
@@ -168,25 +173,45 @@ struct Localizer::State {
       return check;
     }
     const std::shared_ptr<const MapTarget> target = search_target(guess.translation());
-    Fit fit = fit_on(*target, cloud, guess, false);
-    if (!fit.good) {
-      // A street or a corridor looks much the same both ways: the descriptor's heading may be
-      // the map keyframe's where the sensor faces the other way.
-      const Eigen::Isometry3d turned = guess * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ());
-      Fit other = fit_on(*target, cloud, turned, false);
-      if (other.good || other.map.inlier_fraction > fit.map.inlier_fraction) fit = std::move(other);
+    // Where near the proposed place the keyframe's walls fall on the map's, either way round
+    // (a street or a corridor looks much the same both ways: the descriptor's heading may be
+    // the map keyframe's where the sensor faces the other way).
+    std::vector<Eigen::Isometry3d> starts;
+    if (settings.search_reach_m > 0.0) {
+      PlaceCorrelationSettings place;
+      place.reach_m = settings.search_reach_m;
+      place.max_normal_z = kUprightMaxNormalZ;
+      for (const PlacePeak& peak :
+           correlate_place(target->upright, target->observed_columns,
+                           upright_points(cloud, guess.linear(), kUprightMaxNormalZ), guess, place))
+        starts.push_back(peak.T_map_query);
+    }
+    if (starts.empty()) starts = {guess, guess * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())};
+    Fit fit;
+    for (size_t i = 0; i < starts.size() && !found_firmly(fit); ++i) {
+      Fit other = fit_on(*target, cloud, starts[i], false);
+      if (i == 0 || found_firmly(other) || other.map.inlier_fraction > fit.map.inlier_fraction)
+        fit = std::move(other);
     }
     check.fitness_m = fit.map.fitness_m;
     check.inlier_fraction = fit.map.inlier_fraction;
-    if (fit.good) {
+    if (found_firmly(fit)) {
       check.T_map_query = fit.result.T_target_source;
     } else {
       check.rejection = fit.map.coverage < settings.min_coverage ? "surface: little of it mapped"
-                        : fit.map.inlier_fraction < settings.min_inlier_fraction
+                        : fit.map.inlier_fraction < search_min_inlier_fraction()
                             ? "surface: inliers"
                             : "surface: fit";
     }
     return check;
+  }
+
+  double search_min_inlier_fraction() const {
+    return std::min(1.0, settings.min_inlier_fraction + settings.search_extra_inliers);
+  }
+  /// A fit good enough to be found by: a tracked scan's, with more of it on the map.
+  bool found_firmly(const Fit& fit) const {
+    return fit.good && fit.map.inlier_fraction >= search_min_inlier_fraction();
   }
 
   static void add_search_counts(const slam::loops::RelocalizationCounts& from,
@@ -259,7 +284,7 @@ struct Localizer::State {
     out.position_sigma_m = fit.map.position_sigma_m;
     out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
     out.iterations = fit.result.iterations;
-    if (!fit.good) {
+    if (!found_firmly(fit)) {
       ++counts.unconfirmed_matches;
       out.event = "a match with the map's keyframes that its surface does not confirm (" +
                   std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +

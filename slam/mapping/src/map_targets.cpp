@@ -95,7 +95,8 @@ MapTargets::~MapTargets() {
 std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
                                                   const Eigen::Vector3d& centre, double radius_m,
                                                   const std::vector<double>& voxel_sizes_m,
-                                                  double fitness_voxel_m, double block_m) {
+                                                  double fitness_voxel_m, double block_m,
+                                                  double upright_max_normal_z) {
   const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m);
   const std::vector<std::shared_ptr<const ChunkSurface>> surfaces =
       surface.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
@@ -117,6 +118,20 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
       centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
   made->observed = std::move(observed);
   made->block_m = block_m;
+  if (upright_max_normal_z >= 0.0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    for (const slam::refine::VoxelGaussian& part : parts) {
+      eigen.computeDirect(part.covariance);
+      if (std::abs(eigen.eigenvectors().col(0).z()) <= upright_max_normal_z)
+        made->upright.push_back(part.mean.head<2>().cast<float>());
+    }
+    std::unordered_set<uint64_t> columns;
+    for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces)
+      for (const std::array<int32_t, 3>& block : chunk->observed_blocks)
+        if (columns.insert(grid_key({block[0], block[1], 0})).second)
+          made->observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
+                                              static_cast<float>((block[1] + 0.5) * block_m));
+  }
   return made;
 }
 

@@ -32,6 +32,11 @@ struct MapTarget {
   /// grid_key() of the blocks (block_m across) where the map observed anything.
   std::unordered_set<uint64_t> observed;
   double block_m = 0.5;
+  /// Horizontal positions of the upright surface cells (walls, posts: normal within
+  /// build_map_target's upright_max_normal_z of the horizontal), where it was asked for them.
+  std::vector<Eigen::Vector2f> upright;
+  /// ... and of the columns of observed blocks (once each), where upright cells were asked for.
+  std::vector<Eigen::Vector2f> observed_columns;
 };
 
 /// How a scan placed at a pose fits the map: of its points where the map observed anything,
@@ -58,11 +63,13 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
 
 /// The target of the surface within `radius_m` (horizontally) of `centre`, with voxels of
 /// `voxel_sizes_m` (multiples of the surface's cells) and the fit's voxels of `fitness_voxel_m`,
-/// the observed blocks of `block_m`. Reads what the surface has not cached.
+/// the observed blocks of `block_m`, and its upright cells where `upright_max_normal_z` >= 0.
+/// Reads what the surface has not cached.
 std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
                                                   const Eigen::Vector3d& centre, double radius_m,
                                                   const std::vector<double>& voxel_sizes_m,
-                                                  double fitness_voxel_m, double block_m);
+                                                  double fitness_voxel_m, double block_m,
+                                                  double upright_max_normal_z = -1.0);
 
 struct MapTargetCounts {
   size_t built = 0;

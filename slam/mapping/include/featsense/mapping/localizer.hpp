@@ -89,6 +89,16 @@ struct LocalizerSettings {
   size_t search_targets_kept = 8;
   size_t search_ring_candidates = 50;
   size_t search_verifications = 8;
+  /// Each proposed place is registered from the few places within this distance of it (each
+  /// way along x and along y) where the keyframe's upright surfaces, seen from above, best
+  /// cover the map's: a descriptor finds the street, often at a keyframe metres along it,
+  /// farther than a registration slides. 0: from the proposed place alone.
+  double search_reach_m = 24.0;
+  /// A place found from scratch needs this much more of the scan on the map's surface than
+  /// a tracked scan (min_inlier_fraction): at a wrong place in a town of blocks alike, the
+  /// block beside the sensor fits (half of what it sees) and the rest does not; a tracked
+  /// scan has its last pose to vouch for it, a first fix nothing.
+  double search_extra_inliers = 0.1;
 
   static slam::refine::VgicpSettings tracking_vgicp();
 };
