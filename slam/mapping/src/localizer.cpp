@@ -284,7 +284,9 @@ struct Localizer::State {
     out.position_sigma_m = fit.map.position_sigma_m;
     out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
     out.iterations = fit.result.iterations;
-    if (!found_firmly(fit)) {
+    // The keyframes that placed it fitted firmly (check_place); this scan confirms the place
+    // as a tracked scan would.
+    if (!fit.good) {
       ++counts.unconfirmed_matches;
       out.event = "a match with the map's keyframes that its surface does not confirm (" +
                   std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +
