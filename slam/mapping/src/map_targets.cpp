@@ -102,14 +102,22 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
       surface.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
   std::vector<slam::refine::VoxelGaussian> parts;
   std::unordered_set<uint64_t> observed;
+  // The observed blocks' columns, each once, for a target searched from above.
+  const bool with_upright = upright_max_normal_z >= 0.0;
+  std::unordered_set<uint64_t> columns;
+  std::vector<Eigen::Vector2f> observed_columns;
   const double radius2 = radius_m * radius_m;
   for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces) {
     for (const SurfaceCell& cell : chunk->cells) {
       if ((cell.mean.cast<double>() - centre).head<2>().squaredNorm() > radius2) continue;
       parts.push_back(to_voxel_gaussian(cell));
     }
-    for (const std::array<int32_t, 3>& block : chunk->observed_blocks)
+    for (const std::array<int32_t, 3>& block : chunk->observed_blocks) {
       observed.insert(grid_key(block));
+      if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
+        observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
+                                      static_cast<float>((block[1] + 0.5) * block_m));
+    }
   }
   std::vector<slam::refine::VoxelGaussians> levels;
   for (const double voxel_m : voxel_sizes_m) levels.emplace_back(parts, voxel_m);
@@ -118,19 +126,14 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
       centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
   made->observed = std::move(observed);
   made->block_m = block_m;
-  if (upright_max_normal_z >= 0.0) {
+  if (with_upright) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
     for (const slam::refine::VoxelGaussian& part : parts) {
       eigen.computeDirect(part.covariance);
       if (std::abs(eigen.eigenvectors().col(0).z()) <= upright_max_normal_z)
         made->upright.push_back(part.mean.head<2>().cast<float>());
     }
-    std::unordered_set<uint64_t> columns;
-    for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces)
-      for (const std::array<int32_t, 3>& block : chunk->observed_blocks)
-        if (columns.insert(grid_key({block[0], block[1], 0})).second)
-          made->observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
-                                              static_cast<float>((block[1] + 0.5) * block_m));
+    made->observed_columns = std::move(observed_columns);
   }
   return made;
 }

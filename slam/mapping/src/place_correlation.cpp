@@ -136,21 +136,18 @@ double heading_difference_rad(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b
   return std::abs(std::atan2(R(1, 0), R(0, 0)));
 }
 
-/// The best of `places` (best first) at least `separation_m` apart or facing otherwise.
-std::vector<PlacePeak> separated(const std::vector<PlacePeak>& places, double separation_m,
-                                 size_t count) {
-  std::vector<PlacePeak> out;
-  for (const PlacePeak& place : places) {
-    if (out.size() >= count) break;
-    const bool near_taken = std::any_of(out.begin(), out.end(), [&](const PlacePeak& t) {
-      return heading_difference_rad(t.T_map_query.linear(), place.T_map_query.linear()) <
-                 M_PI / 2.0 &&
-             (t.T_map_query.translation() - place.T_map_query.translation()).head<2>().norm() <
-                 separation_m;
-    });
-    if (!near_taken) out.push_back(place);
-  }
-  return out;
+/// Adds `place` to `taken` (at most `count`) unless one there lies within `separation_m` of it
+/// facing alike: fed best first, `taken` keeps the best distinct places.
+void take_if_separated(std::vector<PlacePeak>& taken, const PlacePeak& place, double separation_m,
+                       size_t count) {
+  if (taken.size() >= count) return;
+  const bool near_taken = std::any_of(taken.begin(), taken.end(), [&](const PlacePeak& t) {
+    return heading_difference_rad(t.T_map_query.linear(), place.T_map_query.linear()) <
+               M_PI / 2.0 &&
+           (t.T_map_query.translation() - place.T_map_query.translation()).head<2>().norm() <
+               separation_m;
+  });
+  if (!near_taken) taken.push_back(place);
 }
 
 std::vector<double> radians(const std::vector<double>& degrees) {
@@ -192,14 +189,16 @@ std::vector<PlacePeak> correlate_place(const std::vector<Eigen::Vector2f>& map_u
   const std::vector<Shift> shifts = scored_shifts(coarse, cell, reach, scan_upright,
                                                   settings.scan_range_m, guess.linear(), turns);
   if (shifts.empty()) return {};
-  std::vector<PlacePeak> coarse_places;
-  coarse_places.reserve(shifts.size());
-  for (const Shift& s : shifts) coarse_places.push_back(place_of(s, guess, cell));
+  // The places are made from the best shifts only, as many as are taken.
   const size_t refined_count = std::max(settings.refined, settings.peaks);
-  const std::vector<PlacePeak> best =
-      separated(coarse_places, settings.peak_separation_m, refined_count);
-  if (!(settings.fine_cell_m > 0.0) || settings.fine_cell_m >= cell)
-    return separated(best, settings.peak_separation_m, settings.peaks);
+  std::vector<PlacePeak> best;
+  for (size_t i = 0; i < shifts.size() && best.size() < refined_count; ++i)
+    take_if_separated(best, place_of(shifts[i], guess, cell), settings.peak_separation_m,
+                      refined_count);
+  if (!(settings.fine_cell_m > 0.0) || settings.fine_cell_m >= cell) {
+    best.resize(std::min(best.size(), settings.peaks));
+    return best;
+  }
 
   // Fine: within a coarse cell of each, with finer turns about its heading.
   const double fine = settings.fine_cell_m;
@@ -217,7 +216,10 @@ std::vector<PlacePeak> correlate_place(const std::vector<Eigen::Vector2f>& map_u
   }
   std::stable_sort(fine_places.begin(), fine_places.end(),
                    [](const PlacePeak& a, const PlacePeak& b) { return a.score > b.score; });
-  return separated(fine_places, settings.peak_separation_m, settings.peaks);
+  std::vector<PlacePeak> out;
+  for (const PlacePeak& place : fine_places)
+    take_if_separated(out, place, settings.peak_separation_m, settings.peaks);
+  return out;
 }
 
 }  // namespace featsense::mapping
