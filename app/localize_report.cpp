@@ -152,7 +152,10 @@ nlohmann::json localize_report_json(const config::Config& config, const Localize
                    {"candidates", c.search_candidates},
                    {"verified", c.search_verified},
                    {"surface_refuted", c.unconfirmed_matches},
-                   {"rejected", c.search_rejected}};
+                   {"rejected", c.search_rejected},
+                   {"layout_ms", c.layout_ms},
+                   {"layout_search_ms", bench::timing_json(c.layout_search_ms)},
+                   {"layout_bytes", c.layout_bytes}};
   nlohmann::json events = nlohmann::json::array();
   size_t event_count = 0;
   for (size_t i = 0; i < run.scans.size(); ++i) {

@@ -41,8 +41,11 @@ RelocalizeSettings relocalize_from_config(const config::Config& config) {
 }
 
 Relocalizer::Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings,
-                         PlaceVerifier verifier)
-    : map_(std::move(map)), settings_(settings), verifier_(std::move(verifier)) {
+                         PlaceVerifier verifier, std::shared_ptr<const MapLayout> layout)
+    : map_(std::move(map)),
+      settings_(settings),
+      verifier_(std::move(verifier)),
+      layout_(verifier_ ? std::move(layout) : nullptr) {
   map_poses_.reserve(map_.size());
   for (const MapKeyframe& keyframe : map_) map_poses_.push_back(keyframe.T_map_sensor);
 }
@@ -122,6 +125,34 @@ std::vector<Relocalizer::Candidate> Relocalizer::candidates(
   return out;
 }
 
+void Relocalizer::add_layout_candidates(const std::vector<Eigen::Vector3f>& points,
+                                        const Eigen::Isometry3d& T_session_sensor,
+                                        std::vector<Candidate>& out) {
+  if (!layout_ || map_.empty()) return;
+  std::vector<Eigen::Vector3d> chosen;
+  for (const Candidate& c : out)
+    chosen.push_back((map_poses_[c.map_keyframe] * c.guess).translation());
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<LayoutPeak> peaks = layout_->search(points, levelling(T_session_sensor));
+  counts_.layout_ms.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  for (const LayoutPeak& peak : peaks) {
+    const Eigen::Vector3d at = peak.T_map_query.translation();
+    if (std::any_of(chosen.begin(), chosen.end(),
+                    [&](const Eigen::Vector3d& c) { return (c - at).norm() < kDistinctPlacesM; }))
+      continue;
+    // A candidate is kept relative to a map keyframe: the nearest.
+    size_t nearest = 0;
+    for (size_t j = 1; j < map_.size(); ++j) {
+      if ((map_poses_[j].translation() - at).squaredNorm() <
+          (map_poses_[nearest].translation() - at).squaredNorm())
+        nearest = j;
+    }
+    out.push_back({nearest, map_poses_[nearest].inverse() * peak.T_map_query, "layout", 1.0});
+    chosen.push_back(at);
+  }
+}
+
 bool Relocalizer::agree(const Hypothesis& a, const Hypothesis& b) const {
   const double apart_m = std::abs(a.travelled_m - b.travelled_m);
   const double tolerance_m = settings_.agreement_m + settings_.loop.drift_per_m * apart_m;
@@ -163,45 +194,51 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
   const std::vector<Eigen::Vector3f> kept = CompactCloud(points).points();
   const ScanContext descriptor = levelled_scan_context(T_session_sensor, kept, loop.scan_context);
   const std::vector<Candidate> found = candidates(descriptor, T_session_sensor);
-  counts_.candidates += found.size();
-  if (found.empty()) {
-    done();
-    return std::nullopt;
-  }
+  // The places laid over the whole map only where the keyframes' own proposals hold none: a
+  // room or a block that looks alike turned or a street further is found by them too, and
+  // where a descriptor already found the place they would only make it ambiguous.
+  std::vector<Candidate> wider;
   const refine::GaussianCloud cloud = refine::with_covariances(kept, loop.neighbours);
   const auto reject = [&](const char* reason) { ++counts_.rejected[reason]; };
   struct Verified {
     const Candidate* candidate;
     refine::VgicpResult result;
     Eigen::Isometry3d T_map_query;
+    double coverage = 1.0;
+    /// The share of all its points on the map.
+    double support() const { return result.inlier_fraction * coverage; }
   };
   std::vector<Verified> verified;
-  for (const Candidate& candidate : found) {
-    refine::VgicpResult result;
-    std::optional<Eigen::Isometry3d> placed;
-    if (verifier_) {
-      const PlaceCheck check =
-          verifier_(map_poses_[candidate.map_keyframe] * candidate.guess, cloud);
-      if (check.T_map_query) {
-        placed = check.T_map_query;
-        result.T_target_source = map_poses_[candidate.map_keyframe].inverse() * *placed;
-        result.converged = true;
-        result.fitness_m = check.fitness_m;
-        result.inlier_fraction = check.inlier_fraction;
+  const auto verify = [&](const std::vector<Candidate>& list) {
+    counts_.candidates += list.size();
+    for (const Candidate& candidate : list) {
+      refine::VgicpResult result;
+      std::optional<Eigen::Isometry3d> placed;
+      double coverage = 1.0;
+      if (verifier_) {
+        const PlaceCheck check =
+            verifier_(map_poses_[candidate.map_keyframe] * candidate.guess, cloud);
+        if (check.T_map_query) {
+          placed = check.T_map_query;
+          result.T_target_source = map_poses_[candidate.map_keyframe].inverse() * *placed;
+          result.converged = true;
+          result.fitness_m = check.fitness_m;
+          result.inlier_fraction = check.inlier_fraction;
+          coverage = check.coverage;
+        } else {
+          reject(check.rejection.c_str());
+        }
       } else {
-        reject(check.rejection.c_str());
+        const refine::GaussianCloud target = keyframe_target(
+            map_, map_poses_, candidate.map_keyframe, loop.target_neighbours, loop.neighbours);
+        result = refine::align(target, cloud, candidate.guess, loop.vgicp);
+        if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
+          reject(to_string(*failed));
+        } else {
+          placed = map_poses_[candidate.map_keyframe] * result.T_target_source;
+        }
       }
-    } else {
-      const refine::GaussianCloud target = keyframe_target(map_, map_poses_, candidate.map_keyframe,
-                                                           loop.target_neighbours, loop.neighbours);
-      result = refine::align(target, cloud, candidate.guess, loop.vgicp);
-      if (const std::optional<LoopRejection> failed = fit_rejection(result, loop)) {
-        reject(to_string(*failed));
-      } else {
-        placed = map_poses_[candidate.map_keyframe] * result.T_target_source;
-      }
-    }
-    if (placed) {
+      if (!placed) continue;
       const Eigen::Isometry3d T_map_query = *placed;
       if (candidate.found_by == "guess" &&
           (T_map_query.translation() - (*settings_.guess * T_session_sensor).translation()).norm() >
@@ -210,24 +247,31 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
         continue;
       }
       ++counts_.verified;
-      verified.push_back({&candidate, result, T_map_query});
+      verified.push_back({&candidate, result, T_map_query, coverage});
     }
+  };
+  verify(found);
+  if (verified.empty()) {
+    wider = found;
+    const size_t before = wider.size();
+    add_layout_candidates(kept, T_session_sensor, wider);
+    wider.erase(wider.begin(), wider.begin() + static_cast<std::ptrdiff_t>(before));
+    verify(wider);
   }
   if (verified.empty()) {
     done();
     return std::nullopt;
   }
-  const Verified& best =
-      *std::max_element(verified.begin(), verified.end(), [](const Verified& a, const Verified& b) {
-        return a.result.inlier_fraction < b.result.inlier_fraction;
-      });
+  const Verified& best = *std::max_element(
+      verified.begin(), verified.end(),
+      [](const Verified& a, const Verified& b) { return a.support() < b.support(); });
   const auto session_at = [&](const Verified& v) {
     return Hypothesis{keyframe, travelled_m, v.T_map_query * T_session_sensor.inverse()};
   };
   const bool ambiguous = std::any_of(verified.begin(), verified.end(), [&](const Verified& rival) {
     return (rival.T_map_query.translation() - best.T_map_query.translation()).norm() >
                loop.ambiguity_m &&
-           rival.result.inlier_fraction >= kRivalInlierRatio * best.result.inlier_fraction;
+           rival.support() >= kRivalInlierRatio * best.support();
   });
   if (ambiguous) {
     // Each of its places stays a hypothesis that a later, unambiguous keyframe may pick.

@@ -133,11 +133,24 @@ struct Localizer::State {
   /// a lane over, or driving the other way, sees too much of it otherwise to fit it.
   void new_relocalizer() {
     if (relocalizer) add_search_counts(relocalizer->counts(), counts);
+    if (!layout && settings.search_layout_places > 0) {
+      slam::loops::MapLayoutSettings layout_settings;
+      layout_settings.peaks = settings.search_layout_places;
+      std::vector<Eigen::Isometry3d> poses;
+      for (const slam::loops::MapKeyframe& keyframe : saved.keyframes)
+        poses.push_back(keyframe.T_map_sensor);
+      const auto start = Clock::now();
+      layout =
+          std::make_shared<const slam::loops::MapLayout>(saved.keyframes, poses, layout_settings);
+      counts.layout_ms = ms_since(start);
+      counts.layout_bytes = layout->counts().bytes;
+    }
     relocalizer = std::make_unique<slam::loops::Relocalizer>(
         saved.keyframes, search_settings,
         [this](const Eigen::Isometry3d& guess, const slam::refine::GaussianCloud& cloud) {
           return check_place(guess, cloud);
-        });
+        },
+        layout);
   }
 
   /// The surface around `position` for checking places: kept for the next keyframes, which
@@ -190,11 +203,12 @@ struct Localizer::State {
     Fit fit;
     for (size_t i = 0; i < starts.size() && !found_firmly(fit); ++i) {
       Fit other = fit_on(*target, cloud, starts[i], false);
-      if (i == 0 || found_firmly(other) || other.map.inlier_fraction > fit.map.inlier_fraction)
+      if (i == 0 || found_firmly(other) || other.map.inliers > fit.map.inliers)
         fit = std::move(other);
     }
     check.fitness_m = fit.map.fitness_m;
     check.inlier_fraction = fit.map.inlier_fraction;
+    check.coverage = fit.map.coverage;
     if (found_firmly(fit)) {
       check.T_map_query = fit.result.T_target_source;
     } else {
@@ -220,6 +234,8 @@ struct Localizer::State {
     to.search_candidates += from.candidates;
     to.search_verified += from.verified;
     for (const auto& [reason, n] : from.rejected) to.search_rejected[reason] += n;
+    to.layout_search_ms.insert(to.layout_search_ms.end(), from.layout_ms.begin(),
+                               from.layout_ms.end());
   }
 
   /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to `target` from
@@ -471,6 +487,8 @@ struct Localizer::State {
   std::unique_ptr<slam::odometry::OdometryLocator> odometry;
   Eigen::Isometry3d T_map_odometry = Eigen::Isometry3d::Identity();
   std::unique_ptr<slam::loops::Relocalizer> relocalizer;
+  /// The map from above, made at the first search and kept for every search after it.
+  std::shared_ptr<const slam::loops::MapLayout> layout;
   /// Targets of the places the search checked, the latest first.
   std::list<std::pair<std::array<int64_t, 2>, std::shared_ptr<const MapTarget>>> search_targets;
   std::unique_ptr<slam::loops::KeyframeSelector> selector;

@@ -99,6 +99,12 @@ struct LocalizerSettings {
   /// block beside the sensor fits (half of what it sees) and the rest does not; a tracked
   /// scan has its last pose to vouch for it, a first fix nothing.
   double search_extra_inliers = 0.1;
+  /// A search keyframe none of whose descriptor's places holds is laid over the whole map
+  /// seen from above (slam::loops::MapLayout), and this many of the best places there are
+  /// checked: a sensor that starts on a street the map saw only from a crossing, or tens of
+  /// metres from the nearest keyframe, is proposed no place near it by a descriptor.
+  /// 0: descriptors alone.
+  size_t search_layout_places = 4;
 
   static slam::refine::VgicpSettings tracking_vgicp();
 };
@@ -132,7 +138,7 @@ struct LocalizedScan {
 struct LocalizationFix {
   size_t scan = 0;  ///< scans given before it
   int64_t stamp_ns = 0;
-  std::string found_by;  ///< "descriptor", "guess" or "earlier match"
+  std::string found_by;  ///< "descriptor", "layout", "guess" or "earlier match"
   double descriptor_distance = 1.0;
   double fitness_m = 0.0;  ///< the check against the map's surface
   double inlier_fraction = 0.0;
@@ -160,6 +166,10 @@ struct LocalizerCounts {
   size_t search_candidates = 0;
   size_t search_verified = 0;
   std::map<std::string, size_t> search_rejected;
+  /// The map from above (the layout search's): the time to make it and its size.
+  double layout_ms = 0.0;
+  size_t layout_bytes = 0;
+  std::vector<double> layout_search_ms;  ///< per search keyframe
   size_t map_keyframes = 0;
   size_t map_chunks = 0;
   /// The map's surface: chunks read, reused, the cache's bytes.

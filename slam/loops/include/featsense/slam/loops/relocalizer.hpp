@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -27,6 +28,7 @@
 #include "featsense/config/config.hpp"
 #include "featsense/slam/loops/loop_closer.hpp"
 #include "featsense/slam/loops/map_keyframe.hpp"
+#include "featsense/slam/loops/map_layout.hpp"
 
 namespace featsense::slam::loops {
 
@@ -59,6 +61,7 @@ struct RelocalizationCounts {
   size_t verified = 0;
   std::map<std::string, size_t> rejected;  ///< by reason
   std::vector<double> keyframe_ms;
+  std::vector<double> layout_ms;  ///< the layout's search, per keyframe where there is one
 };
 
 /// The match that placed the session.
@@ -81,6 +84,11 @@ struct PlaceCheck {
   std::optional<Eigen::Isometry3d> T_map_query;
   double fitness_m = 0.0;
   double inlier_fraction = 0.0;
+  /// The share of the points where the map observed anything (inlier_fraction is of those):
+  /// of two places for one keyframe, the one with more of all its points on the map is
+  /// the better (a place that puts the points where the map never looked fits the few
+  /// left).
+  double coverage = 1.0;
   std::string rejection;  ///< where there is no place
 };
 /// From the guess of the query keyframe's pose in the map and its points (sensor frame).
@@ -91,8 +99,11 @@ class Relocalizer {
  public:
   /// `map` sorted by (session, index), each keyframe's travelled_m filled. `verifier`, where
   /// given, checks each candidate in place of the registration to the map keyframe's cloud.
+  /// `layout`, where given (with a verifier: its places may lie far from any keyframe),
+  /// proposes the places where a keyframe's upright columns best fit the map's, for a
+  /// keyframe none of whose other candidates holds.
   Relocalizer(std::vector<MapKeyframe> map, const RelocalizeSettings& settings,
-              PlaceVerifier verifier = {});
+              PlaceVerifier verifier = {}, std::shared_ptr<const MapLayout> layout = nullptr);
 
   /// The next keyframe of the new session: its stamp, its front-end pose in the session's
   /// frame, how far along the session's path, its points in the sensor frame (deskewed,
@@ -120,6 +131,10 @@ class Relocalizer {
   };
   std::vector<Candidate> candidates(const ScanContext& descriptor,
                                     const Eigen::Isometry3d& T_session_sensor) const;
+  /// The layout's places for a keyframe, but those near a candidate already chosen.
+  void add_layout_candidates(const std::vector<Eigen::Vector3f>& points,
+                             const Eigen::Isometry3d& T_session_sensor,
+                             std::vector<Candidate>& out);
   bool agree(const Hypothesis& a, const Hypothesis& b) const;
   /// Earlier keyframes with a place that agrees with `hypothesis` (plus its own: 1 at least),
   /// and those without one. An ambiguous keyframe counts once, with any of its places.
@@ -129,6 +144,7 @@ class Relocalizer {
   std::vector<Eigen::Isometry3d> map_poses_;
   RelocalizeSettings settings_;
   PlaceVerifier verifier_;
+  std::shared_ptr<const MapLayout> layout_;
   std::vector<Hypothesis> hypotheses_;
   std::optional<Relocalization> placement_;
   RelocalizationCounts counts_;
