@@ -1,6 +1,7 @@
 #include "surface_cells.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <unordered_map>
 
@@ -96,18 +97,22 @@ ChunkSurface chunk_surface(const storage::ChunkKey& key, const storage::Chunk& c
   }
   std::vector<uint8_t> observed_block(
       static_cast<size_t>(blocks_across[0]) * blocks_across[1] * blocks_across[2], 0);
+  // The block of each voxel's centre along each axis, once per chunk rather than per voxel.
+  std::array<std::array<size_t, kN>, 3> block_of{};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int32_t i = 0; i < kN; ++i) {
+      const double centre = (origin[axis] + (i + 0.5)) * settings.voxel_m;
+      block_of[axis][static_cast<size_t>(i)] =
+          static_cast<size_t>(floor_index(centre, settings.block_m) - first_block[axis]);
+    }
+  }
   for (int32_t z = 0; z < kN; ++z) {
     for (int32_t y = 0; y < kN; ++y) {
       for (int32_t x = 0; x < kN; ++x) {
         if (!field.observed(x, y, z)) continue;
-        const Eigen::Vector3d centre =
-            (origin + Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5)) * settings.voxel_m;
-        const size_t bx =
-            static_cast<size_t>(floor_index(centre.x(), settings.block_m) - first_block[0]);
-        const size_t by =
-            static_cast<size_t>(floor_index(centre.y(), settings.block_m) - first_block[1]);
-        const size_t bz =
-            static_cast<size_t>(floor_index(centre.z(), settings.block_m) - first_block[2]);
+        const size_t bx = block_of[0][static_cast<size_t>(x)];
+        const size_t by = block_of[1][static_cast<size_t>(y)];
+        const size_t bz = block_of[2][static_cast<size_t>(z)];
         observed_block[bx + blocks_across[0] * (by + blocks_across[1] * bz)] = 1;
         const int32_t a = field.value(x, y, z);
         for (int axis = 0; axis < 3; ++axis) {
