@@ -91,6 +91,27 @@ TEST(Vgicp, RecoversAKnownMotionFromHalfAMetreAndFiveDegrees) {
   EXPECT_LT(r.fitness_m, 0.03);  // the samplings' noise: 1 cm per axis
 }
 
+TEST(Vgicp, AGuessGoodToCentimetresNeedsNoCoarseLevel) {
+  const mesh::TriangleMesh lab = build_scene("lab");
+  const auto a = sample_scene(lab, {0, 0, 1.5f}, 10.0f, 30000, 0.01f, 5);
+  const auto b = sample_scene(lab, {0, 0, 1.5f}, 10.0f, 15000, 0.01f, 6);
+  const Eigen::Isometry3d truth = pose(0.3, 0.02, -0.01, {1.2, -0.4, 0.1});
+  const GaussianCloud source = with_covariances(moved(b, truth.inverse()), 20);
+  VgicpSettings settings;
+  settings.voxel_sizes_m = {1.0, 0.5, 0.25};
+  const VgicpTarget target(with_covariances(a, 20), settings);
+  const Eigen::Isometry3d near = truth * pose(0.5 * M_PI / 180.0, 0, 0, {0.04, -0.03, 0.0});
+  for (const size_t first_level : {size_t{0}, size_t{1}, size_t{2}, size_t{9}}) {
+    const VgicpResult r = align(target, source, near, settings, first_level);
+    EXPECT_LT((r.T_target_source.translation() - truth.translation()).norm(), 0.01) << first_level;
+    EXPECT_LT(angle_deg(r.T_target_source, truth), 0.1) << first_level;
+    EXPECT_GT(r.inlier_fraction, 0.9) << first_level;  // measured at the finest level
+  }
+  // From the finest level alone fewer iterations than from the coarsest.
+  EXPECT_LT(align(target, source, near, settings, 2).iterations,
+            align(target, source, near, settings, 0).iterations);
+}
+
 TEST(Vgicp, EmptyCloudsGiveTheGuessNotConverged) {
   const Eigen::Isometry3d guess = pose(0.1, 0, 0, {1, 2, 3});
   const VgicpResult r = align(GaussianCloud{}, GaussianCloud{}, guess);

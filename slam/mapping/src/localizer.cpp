@@ -241,12 +241,13 @@ struct Localizer::State {
   /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to `target` from
   /// `guess`, at each of its voxel sizes or at the finest alone, and judged.
   Fit fit_on(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
-             const Eigen::Isometry3d& guess, bool finest_only) const {
+             const Eigen::Isometry3d& guess, bool finest_only, size_t first_level = 0) const {
     Fit fit;
     fit.points = cloud.size();
-    fit.result = finest_only ? slam::refine::align_to_voxels(target.vgicp.levels.back(), cloud,
-                                                             guess, settings.vgicp)
-                             : slam::refine::align(target.vgicp, cloud, guess, settings.vgicp);
+    fit.result = finest_only
+                     ? slam::refine::align_to_voxels(target.vgicp.levels.back(), cloud, guess,
+                                                     settings.vgicp)
+                     : slam::refine::align(target.vgicp, cloud, guess, settings.vgicp, first_level);
     judge(target, cloud, fit);
     return fit;
   }
@@ -410,7 +411,11 @@ struct Localizer::State {
     Fit fit;
     if (cloud.measured.size() >= kMinPoints) {
       const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
-      fit = fit_on(*target, deskewed(cloud, sweep_to(predicted)), predicted, false);
+      // Tracked without a break, the prediction is good to centimetres: the coarsest voxels
+      // add nothing to the finer ones.
+      const size_t first_level =
+          status == LocalizeStatus::kLocalized && good_in_row > 0 ? settings.steady_first_level : 0;
+      fit = fit_on(*target, deskewed(cloud, sweep_to(predicted)), predicted, false, first_level);
       // Deskewed again with the motion found, and registered again from there; where that
       // fits worse than the first (it went astray), the first stands.
       const Eigen::Isometry3d found = fit.result.T_target_source;

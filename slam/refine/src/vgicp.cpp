@@ -312,12 +312,14 @@ VgicpTarget::VgicpTarget(std::vector<VoxelGaussians> levels_in, VoxelGaussians f
     : levels(std::move(levels_in)), fitness(std::move(fitness_in)) {}
 
 VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
-                  const Eigen::Isometry3d& guess, const VgicpSettings& settings) {
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings,
+                  size_t first_level) {
   VgicpResult result;
   result.T_target_source = guess;
-  for (const VoxelGaussians& level : target.levels) {
+  for (size_t l = std::min(first_level, target.levels.size() - (target.levels.empty() ? 0 : 1));
+       l < target.levels.size(); ++l) {
     const int iterations = result.iterations;
-    result = solve(level, source, result.T_target_source, settings);
+    result = solve(target.levels[l], source, result.T_target_source, settings);
     result.iterations += iterations;
   }
   if (!target.levels.empty() && source.size() > 0 && target.levels.back().size() > 0) {

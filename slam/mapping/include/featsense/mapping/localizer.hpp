@@ -75,6 +75,9 @@ struct LocalizerSettings {
   int neighbours = 10;
   /// Voxels of the map's surface observed at least this much (as its mesh's).
   double min_weight = 0.5;
+  /// The tracking's first registration of a scan that follows a localized one starts at this
+  /// level of the voxels (0: the coarsest, vgicp.voxel_sizes_m).
+  size_t steady_first_level = 1;
   /// Fits in a row after which the odometry stops and constant velocity predicts.
   size_t settle_scans = 5;
   /// The search: each place a keyframe's descriptor proposes is checked by registering the

@@ -94,9 +94,12 @@ struct VgicpTarget {
   VoxelGaussians fitness;
 };
 
-/// align() on a target made beforehand (with the same settings).
+/// align() on a target made beforehand (with the same settings), from its level
+/// `first_level` (0: the coarsest) on: a guess good to well within a finer level's voxel
+/// needs no coarser one.
 VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
-                  const Eigen::Isometry3d& guess, const VgicpSettings& settings = {});
+                  const Eigen::Isometry3d& guess, const VgicpSettings& settings = {},
+                  size_t first_level = 0);
 
 /// One of several sources registered together: the correction found moves each by its share
 /// of it (a drift that grows along a stretch of scans: share 0 at its start, 1 at its end).
