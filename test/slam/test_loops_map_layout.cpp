@@ -75,10 +75,9 @@ std::vector<Eigen::Vector3f> seen_from(const std::vector<Eigen::Vector3f>& world
 
 /// Keyframes every 10 m along y = -40 from x = -60 to 60 + 120 (copies - 1), their clouds
 /// what they see within 60 m.
-std::pair<std::vector<MapKeyframe>, std::vector<Eigen::Isometry3d>> keyframes_along(
-    const std::vector<Eigen::Vector3f>& world, int copies = 1) {
+std::vector<MapKeyframe> keyframes_along(const std::vector<Eigen::Vector3f>& world,
+                                         int copies = 1) {
   std::vector<MapKeyframe> keyframes;
-  std::vector<Eigen::Isometry3d> poses;
   for (double x = -60.0; x <= 60.0 + 120.0 * (copies - 1); x += 10.0) {
     MapKeyframe keyframe;
     keyframe.index = static_cast<uint32_t>(keyframes.size());
@@ -86,10 +85,9 @@ std::pair<std::vector<MapKeyframe>, std::vector<Eigen::Isometry3d>> keyframes_al
     const std::vector<Eigen::Vector3f> points = seen_from(world, keyframe.T_map_sensor, 60.0);
     keyframe.descriptor = make_scan_context(points);
     keyframe.cloud = CompactCloud(points);
-    poses.push_back(keyframe.T_map_sensor);
     keyframes.push_back(std::move(keyframe));
   }
-  return {keyframes, poses};
+  return keyframes;
 }
 
 double heading_error_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -98,8 +96,8 @@ double heading_error_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b)
 
 TEST(MapLayout, FindsAScanFarFromEveryKeyframeAtAnyHeading) {
   const std::vector<Eigen::Vector3f> world = district();
-  const auto [keyframes, poses] = keyframes_along(world);
-  const MapLayout layout(keyframes, poses);
+  const std::vector<MapKeyframe> keyframes = keyframes_along(world);
+  const MapLayout layout(keyframes);
   EXPECT_GT(layout.counts().upright_cells, 500u);
   // 50 m from the nearest keyframe, turned 137 degrees and tilted 3 degrees; every other
   // point of what it sees.
@@ -115,14 +113,14 @@ TEST(MapLayout, FindsAScanFarFromEveryKeyframeAtAnyHeading) {
 
 TEST(MapLayout, TheBoundedSearchFindsWhatTryingEveryPlaceFinds) {
   const std::vector<Eigen::Vector3f> world = district();
-  const auto [keyframes, poses] = keyframes_along(world);
+  const std::vector<MapKeyframe> keyframes = keyframes_along(world);
   MapLayoutSettings settings;
   settings.scan_range_m = 20.0;  // fewer headings: the exhaustive search stays short
   settings.min_score = 0.0;
   MapLayoutSettings every = settings;
   every.exhaustive = true;
-  const MapLayout bounded(keyframes, poses, settings);
-  const MapLayout exhaustive(keyframes, poses, every);
+  const MapLayout bounded(keyframes, settings);
+  const MapLayout exhaustive(keyframes, every);
   for (const Eigen::Isometry3d& truth :
        {pose(-40.0, 0.0, {-25.0, 5.0, 1.8}), pose(75.0, 0.0, {30.0, -20.0, 1.8})}) {
     const std::vector<Eigen::Vector3f> points = seen_from(world, truth, 20.0);
@@ -138,8 +136,8 @@ TEST(MapLayout, TheBoundedSearchFindsWhatTryingEveryPlaceFinds) {
 
 TEST(MapLayout, TwinBlocksAreBothProposed) {
   const std::vector<Eigen::Vector3f> world = district(2);
-  const auto [keyframes, poses] = keyframes_along(world, 2);
-  const MapLayout layout(keyframes, poses);
+  const std::vector<MapKeyframe> keyframes = keyframes_along(world, 2);
+  const MapLayout layout(keyframes);
   const Eigen::Isometry3d truth = pose(20.0, 0.0, {-10.0, 0.0, 1.8});
   const std::vector<LayoutPeak> peaks =
       layout.search(seen_from(world, truth, 40.0), levelling(truth));
@@ -158,8 +156,8 @@ TEST(MapLayout, TwinBlocksAreBothProposed) {
 
 TEST(MapLayout, AScanOfGroundAloneProposesNothing) {
   const std::vector<Eigen::Vector3f> world = district();
-  const auto [keyframes, poses] = keyframes_along(world);
-  const MapLayout layout(keyframes, poses);
+  const std::vector<MapKeyframe> keyframes = keyframes_along(world);
+  const MapLayout layout(keyframes);
   std::vector<Eigen::Vector3f> ground;
   for (double x = -30.0; x <= 30.0; x += 0.5)
     for (double y = -30.0; y <= 30.0; y += 0.5) ground.emplace_back(x, y, -1.8);
@@ -167,7 +165,7 @@ TEST(MapLayout, AScanOfGroundAloneProposesNothing) {
 }
 
 TEST(MapLayout, AnEmptyMapProposesNothing) {
-  const MapLayout layout({}, {});
+  const MapLayout layout({});
   EXPECT_EQ(layout.counts().upright_cells, 0u);
   const std::vector<Eigen::Vector3f> world = district();
   EXPECT_TRUE(
@@ -179,11 +177,10 @@ TEST(MapLayout, AnEmptyMapProposesNothing) {
 TEST(MapLayout, AMapTooWideForItsCellsIsSearchedByNothing) {
   // Two keyframes 20,000 km apart: a grid of metre cells between them would not fit anywhere.
   const std::vector<Eigen::Vector3f> world = district();
-  auto [keyframes, poses] = keyframes_along(world);
+  std::vector<MapKeyframe> keyframes = keyframes_along(world);
   keyframes.resize(2);
-  poses.resize(2);
-  poses[1].translation().x() = 2e7;
-  const MapLayout layout(keyframes, poses);
+  keyframes[1].T_map_sensor.translation().x() = 2e7;
+  const MapLayout layout(keyframes);
   EXPECT_TRUE(layout.counts().too_large);
   const Eigen::Isometry3d at = pose(0.0, 0.0, {0, 0, 1.8});
   EXPECT_TRUE(layout.search(seen_from(world, at, 40.0), levelling(at)).empty());
@@ -194,7 +191,7 @@ TEST(MapLayout, AMapTooWideForItsCellsIsSearchedByNothing) {
 /// oracle: a place within 3 m and 5 degrees of the truth is the truth, any other is refused.
 std::optional<Relocalization> place_far_recording(bool with_layout) {
   const std::vector<Eigen::Vector3f> world = district();
-  auto [keyframes, poses] = keyframes_along(world);
+  std::vector<MapKeyframe> keyframes = keyframes_along(world);
   travelled_from_positions(keyframes);
   Eigen::Isometry3d truth;
   const PlaceVerifier oracle = [&](const Eigen::Isometry3d& guess, const refine::GaussianCloud&) {
@@ -209,7 +206,7 @@ std::optional<Relocalization> place_far_recording(bool with_layout) {
     return check;
   };
   MapLayoutSettings settings;
-  const auto layout = std::make_shared<const MapLayout>(keyframes, poses, settings);
+  const auto layout = std::make_shared<const MapLayout>(keyframes, settings);
   Relocalizer relocalizer(keyframes, RelocalizeSettings{}, oracle, with_layout ? layout : nullptr);
   const Eigen::Isometry3d first = pose(137.0, 0.0, {20.0, 10.0, 1.8});
   std::optional<Relocalization> placed;

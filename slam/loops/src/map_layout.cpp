@@ -111,14 +111,16 @@ struct Leaf {
 
 }  // namespace
 
-MapLayout::MapLayout(const std::vector<MapKeyframe>& keyframes,
-                     const std::vector<Eigen::Isometry3d>& poses, const MapLayoutSettings& settings)
+MapLayout::MapLayout(const std::vector<MapKeyframe>& keyframes, const MapLayoutSettings& settings)
     : settings_(settings) {
-  const size_t count = std::min(keyframes.size(), poses.size());
+  const size_t count = keyframes.size();
   counts_.keyframes = count;
   if (count == 0 || !(settings_.cell_m > 0.0) || !(settings_.height_bin_m > 0.0)) return;
-  for (size_t k = 0; k < count; ++k)
-    if (!poses[k].matrix().allFinite()) return;
+  std::vector<Eigen::Isometry3d> poses;
+  for (const MapKeyframe& keyframe : keyframes) {
+    if (!keyframe.T_map_sensor.matrix().allFinite()) return;
+    poses.push_back(keyframe.T_map_sensor);
+  }
   const double cell = settings_.cell_m;
   // The grid: every keyframe's points' reach, with room around it for every scan column and
   // every square of places.

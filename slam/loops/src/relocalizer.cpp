@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "featsense/slam/trajectory/trajectory_metrics.hpp"
@@ -78,15 +79,7 @@ std::vector<Relocalizer::Candidate> Relocalizer::candidates(
   for (auto h = hypotheses_.rbegin(); h != hypotheses_.rend() && from_matches < kMatchGuesses;
        ++h) {
     const Eigen::Isometry3d T_map_query = h->T_map_session * T_session_sensor;
-    size_t nearest = map_.size();
-    double best = settings_.loop.drift_base_m;
-    for (size_t j = 0; j < map_.size(); ++j) {
-      const double d = (map_poses_[j].translation() - T_map_query.translation()).norm();
-      if (d <= best) {
-        best = d;
-        nearest = j;
-      }
-    }
+    const size_t nearest = nearest_keyframe(T_map_query.translation(), settings_.loop.drift_base_m);
     if (nearest == map_.size() || near_any(chosen, map_poses_, nearest)) continue;
     out.push_back({nearest, map_poses_[nearest].inverse() * T_map_query, "earlier match", 1.0});
     chosen.push_back(nearest);
@@ -125,12 +118,26 @@ std::vector<Relocalizer::Candidate> Relocalizer::candidates(
   return out;
 }
 
-void Relocalizer::add_layout_candidates(const std::vector<Eigen::Vector3f>& points,
-                                        const Eigen::Isometry3d& T_session_sensor,
-                                        std::vector<Candidate>& out) {
-  if (!layout_ || map_.empty()) return;
+size_t Relocalizer::nearest_keyframe(const Eigen::Vector3d& at, double within_m) const {
+  size_t nearest = map_.size();
+  double best = within_m;
+  for (size_t j = 0; j < map_.size(); ++j) {
+    const double d = (map_poses_[j].translation() - at).norm();
+    if (d <= best) {
+      best = d;
+      nearest = j;
+    }
+  }
+  return nearest;
+}
+
+std::vector<Relocalizer::Candidate> Relocalizer::layout_candidates(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Isometry3d& T_session_sensor,
+    const std::vector<Candidate>& tried) {
+  std::vector<Candidate> out;
+  if (!layout_ || map_.empty()) return out;
   std::vector<Eigen::Vector3d> chosen;
-  for (const Candidate& c : out)
+  for (const Candidate& c : tried)
     chosen.push_back((map_poses_[c.map_keyframe] * c.guess).translation());
   const auto start = std::chrono::steady_clock::now();
   const std::vector<LayoutPeak> peaks = layout_->search(points, levelling(T_session_sensor));
@@ -142,15 +149,11 @@ void Relocalizer::add_layout_candidates(const std::vector<Eigen::Vector3f>& poin
                     [&](const Eigen::Vector3d& c) { return (c - at).norm() < kDistinctPlacesM; }))
       continue;
     // A candidate is kept relative to a map keyframe: the nearest.
-    size_t nearest = 0;
-    for (size_t j = 1; j < map_.size(); ++j) {
-      if ((map_poses_[j].translation() - at).squaredNorm() <
-          (map_poses_[nearest].translation() - at).squaredNorm())
-        nearest = j;
-    }
+    const size_t nearest = nearest_keyframe(at, std::numeric_limits<double>::infinity());
     out.push_back({nearest, map_poses_[nearest].inverse() * peak.T_map_query, "layout", 1.0});
     chosen.push_back(at);
   }
+  return out;
 }
 
 bool Relocalizer::agree(const Hypothesis& a, const Hypothesis& b) const {
@@ -194,10 +197,6 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
   const std::vector<Eigen::Vector3f> kept = CompactCloud(points).points();
   const ScanContext descriptor = levelled_scan_context(T_session_sensor, kept, loop.scan_context);
   const std::vector<Candidate> found = candidates(descriptor, T_session_sensor);
-  // The places laid over the whole map only where the keyframes' own proposals hold none: a
-  // room or a block that looks alike turned or a street further is found by them too, and
-  // where a descriptor already found the place they would only make it ambiguous.
-  std::vector<Candidate> wider;
   const refine::GaussianCloud cloud = refine::with_covariances(kept, loop.neighbours);
   const auto reject = [&](const char* reason) { ++counts_.rejected[reason]; };
   struct Verified {
@@ -251,11 +250,12 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
     }
   };
   verify(found);
+  // The places laid over the whole map only where the keyframe's own proposals hold none: a
+  // room or a block that looks alike turned or a street further is found by them too, and
+  // where a descriptor already found the place they would only make it ambiguous.
+  std::vector<Candidate> wider;
   if (verified.empty()) {
-    wider = found;
-    const size_t before = wider.size();
-    add_layout_candidates(kept, T_session_sensor, wider);
-    wider.erase(wider.begin(), wider.begin() + static_cast<std::ptrdiff_t>(before));
+    wider = layout_candidates(kept, T_session_sensor, found);
     verify(wider);
   }
   if (verified.empty()) {

@@ -136,12 +136,8 @@ struct Localizer::State {
     if (!layout && settings.search_layout_places > 0) {
       slam::loops::MapLayoutSettings layout_settings;
       layout_settings.peaks = settings.search_layout_places;
-      std::vector<Eigen::Isometry3d> poses;
-      for (const slam::loops::MapKeyframe& keyframe : saved.keyframes)
-        poses.push_back(keyframe.T_map_sensor);
       const auto start = Clock::now();
-      layout =
-          std::make_shared<const slam::loops::MapLayout>(saved.keyframes, poses, layout_settings);
+      layout = std::make_shared<const slam::loops::MapLayout>(saved.keyframes, layout_settings);
       counts.layout_ms = ms_since(start);
       counts.layout_bytes = layout->counts().bytes;
     }

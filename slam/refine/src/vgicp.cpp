@@ -316,8 +316,9 @@ VgicpResult align(const VgicpTarget& target, const GaussianCloud& source,
                   size_t first_level) {
   VgicpResult result;
   result.T_target_source = guess;
-  for (size_t l = std::min(first_level, target.levels.size() - (target.levels.empty() ? 0 : 1));
-       l < target.levels.size(); ++l) {
+  // A first level beyond the finest is the finest.
+  const size_t first = target.levels.empty() ? 0 : std::min(first_level, target.levels.size() - 1);
+  for (size_t l = first; l < target.levels.size(); ++l) {
     const int iterations = result.iterations;
     result = solve(target.levels[l], source, result.T_target_source, settings);
     result.iterations += iterations;

@@ -79,9 +79,9 @@ struct MapLayoutCounts {
 
 class MapLayout {
  public:
-  /// The layout of `keyframes`' points at `poses` (the same order).
-  MapLayout(const std::vector<MapKeyframe>& keyframes, const std::vector<Eigen::Isometry3d>& poses,
-            const MapLayoutSettings& settings = {});
+  /// The layout of `keyframes`' points, each at its T_map_sensor.
+  explicit MapLayout(const std::vector<MapKeyframe>& keyframes,
+                     const MapLayoutSettings& settings = {});
 
   /// The best places for a scan whose points (sensor frame) are `points`, turned upright by
   /// `levelling` (the sensor's roll and pitch; its heading is searched): best first, at most
@@ -90,10 +90,6 @@ class MapLayout {
   std::vector<LayoutPeak> search(const std::vector<Eigen::Vector3f>& points,
                                  const Eigen::Matrix3d& levelling) const;
 
-  /// The columns' values (2 upright, 1 next to upright, -1 observed free of upright, 0
-  /// unknown), row major from the map's lower corner: for tests and pictures.
-  const std::vector<int8_t>& cells() const { return levels_.front(); }
-  Eigen::Vector2d origin() const { return origin_; }
   const MapLayoutCounts& counts() const { return counts_; }
 
  private:
@@ -111,7 +107,9 @@ class MapLayout {
   Eigen::Vector2i search_lo_ = Eigen::Vector2i::Zero();
   Eigen::Vector2i search_hi_ = Eigen::Vector2i::Zero();
   int pad_ = 0;
-  /// levels_[h]: the best column value over the 2^h x 2^h cells from each cell up.
+  /// levels_[h]: the best column value over the 2^h x 2^h cells from each cell up; levels_[0]
+  /// the columns' own (2 upright, 1 next to upright, -1 observed free of upright, 0 unknown),
+  /// row major from origin_.
   std::vector<std::vector<int8_t>> levels_;
   /// The keyframes' positions, for a found place's height.
   std::vector<Eigen::Vector3d> keyframe_positions_;

@@ -131,10 +131,12 @@ class Relocalizer {
   };
   std::vector<Candidate> candidates(const ScanContext& descriptor,
                                     const Eigen::Isometry3d& T_session_sensor) const;
-  /// The layout's places for a keyframe, but those near a candidate already chosen.
-  void add_layout_candidates(const std::vector<Eigen::Vector3f>& points,
-                             const Eigen::Isometry3d& T_session_sensor,
-                             std::vector<Candidate>& out);
+  /// The layout's places for a keyframe, but those near a candidate already tried.
+  std::vector<Candidate> layout_candidates(const std::vector<Eigen::Vector3f>& points,
+                                           const Eigen::Isometry3d& T_session_sensor,
+                                           const std::vector<Candidate>& tried);
+  /// The map keyframe nearest `at` within `within_m`; map().size() where none is.
+  size_t nearest_keyframe(const Eigen::Vector3d& at, double within_m) const;
   bool agree(const Hypothesis& a, const Hypothesis& b) const;
   /// Earlier keyframes with a place that agrees with `hypothesis` (plus its own: 1 at least),
   /// and those without one. An ambiguous keyframe counts once, with any of its places.
