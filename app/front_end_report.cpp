@@ -110,6 +110,10 @@ nlohmann::json loops_json(const mapping::LoopOutcome& outcome, double finish_ms)
     gravity_json["rms_whitened"] = gravity.rms_whitened;
   }
   const slam::loops::PoseGraphSummary& last = outcome.final_optimisation;
+  if (last.gravity_agreement.observations > 0) {
+    gravity_json["window_model_deg"] = last.gravity_agreement.model_rad * kDegrees;
+    gravity_json["window_scatter_deg"] = last.gravity_agreement.scatter_rad * kDegrees;
+  }
   nlohmann::json gyro_json = {{"edges", last.gyro_edges},
                               {"consistent_with_lidar", last.turn_agreement.consistent}};
   if (last.turn_agreement.edges > 0) {

@@ -154,6 +154,29 @@ TEST(GravityReference, TheOdometrysJitterAveragesOverTheWindow) {
   EXPECT_LT(worst, 0.04);
 }
 
+TEST(GravityReference, AWindowThatAcceleratesIsAsUncertainAsTheOdometrysAcceleration) {
+  // The odometry's acceleration errs alike in every bend: a window's error grows with the
+  // acceleration it takes from the odometry, 3 % of it by default.
+  const Drive drive(ImuModel::exact());
+  GravitySettings exact_odometry;
+  exact_odometry.odometry_acceleration_error = 0.0;
+  const std::vector<GravityObservation> with_error =
+      gravity_observations(drive.stamps_ns, drive.poses, drive.imu, drive.keyframes(), {});
+  const std::vector<GravityObservation> without = gravity_observations(
+      drive.stamps_ns, drive.poses, drive.imu, drive.keyframes(), exact_odometry);
+  ASSERT_EQ(with_error.size(), without.size());
+  double largest = 0.0;
+  for (size_t i = 0; i < with_error.size(); ++i) {
+    const double a = with_error[i].path_acceleration.norm();
+    largest = std::max(largest, a);
+    const double odometry_rad = 0.03 * a / std::max(with_error[i].up().norm(), 1.0);
+    EXPECT_NEAR(with_error[i].sigma_rad * with_error[i].sigma_rad -
+                    without[i].sigma_rad * without[i].sigma_rad,
+                odometry_rad * odometry_rad * with_error[i].shared, 1e-12);
+  }
+  EXPECT_GT(largest, 0.3);  // the drive does accelerate
+}
+
 TEST(GravityReference, ATiltedMapFrameShowsAsTheSameTiltOfEveryKeyframe) {
   // The odometry's whole path tilted by 2 degrees (the first scan's tilt kept as the map's):
   // the observations, made of relative rotations only, are the same; put in the tilted map

@@ -220,9 +220,9 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
     for (size_t j = 0; j < kernel.weights().size(); ++j)
       acceleration += kernel.weights()[j] * path[first_position + j].translation();
     o.path_acceleration = R_k_map * acceleration;
-    // The noise of the mean force (white per sample), of the positions' fit and the floor, as
-    // an angle; the windows of the keyframes around share their samples, so each counts for a
-    // share.
+    // The noise of the mean force (white per sample), of the positions' fit, the odometry's
+    // share of its acceleration and the floor, as an angle; the windows of the keyframes
+    // around share their samples, so each counts for a share.
     double squared_weights = 0.0;
     for (const double w : kernel.weights()) squared_weights += w * w;
     const double accel =
@@ -232,7 +232,9 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
     const auto shared = static_cast<double>(
         std::upper_bound(keyframe_stamps_ns.begin(), keyframe_stamps_ns.end(), kernel.end_ns()) -
         std::lower_bound(keyframe_stamps_ns.begin(), keyframe_stamps_ns.end(), kernel.begin_ns()));
-    o.sigma_rad = std::sqrt(accel * accel + positions * positions +
+    o.shared = std::max(1.0, shared);
+    const double odometry = settings.odometry_acceleration_error * o.path_acceleration.norm();
+    o.sigma_rad = std::sqrt(accel * accel + positions * positions + odometry * odometry +
                             settings.min_sigma_mps2 * settings.min_sigma_mps2) /
                   up * std::sqrt(std::max(1.0, shared));
     out.push_back(o);

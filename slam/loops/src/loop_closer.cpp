@@ -369,8 +369,13 @@ PoseGraphSummary LoopCloser::finish(const std::vector<int64_t>& path_stamps_ns,
   std::vector<int64_t> keyframe_stamps_ns;
   keyframe_stamps_ns.reserve(keyframes_.size());
   for (const Keyframe& keyframe : keyframes_) keyframe_stamps_ns.push_back(keyframe.stamp_ns);
-  const std::vector<GravityObservation> observations =
+  std::vector<GravityObservation> observations =
       gravity_observations(path_stamps_ns, path, samples, keyframe_stamps_ns, settings_.gravity);
+  std::vector<Eigen::Matrix3d> R_map_node;
+  R_map_node.reserve(graph_.size());
+  for (const Eigen::Isometry3d& pose : graph_.poses()) R_map_node.push_back(pose.rotation());
+  const GravityAgreement gravity_agreement =
+      weigh_gravity_against_lidar(&observations, R_map_node, settings_.gravity.bias_prior_mps2);
   for (const GravityObservation& observation : observations)
     graph_.add_gravity(observation, settings_.gravity.bias_prior_mps2);
   std::vector<GyroObservation> turns =
@@ -381,6 +386,7 @@ PoseGraphSummary LoopCloser::finish(const std::vector<int64_t>& path_stamps_ns,
   if (loops_.empty() && observations.empty() && turns.empty()) return {};
   PoseGraphSummary summary = optimise_timed();
   summary.turn_agreement = agreement;
+  summary.gravity_agreement = gravity_agreement;
   return summary;
 }
 

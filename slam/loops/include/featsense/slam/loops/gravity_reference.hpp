@@ -31,6 +31,11 @@ struct GravitySettings {
   /// positions against its neighbours' (its scan-to-scan jitter, not its drift).
   double accel_noise_mps2 = 0.02;
   double position_sigma_m = 0.005;
+  /// The odometry's acceleration over a window errs by this share of itself, alike in every
+  /// bend, so that it does not average out: its scale (LiDAR odometry's relative translation
+  /// error is 0.5-1 %), and the turn rate times the milliseconds by which a sweep's pose and
+  /// its stamp differ (1.3 rad/s in a 3 m bend at 4 m/s: 10 ms is 1.3 %).
+  double odometry_acceleration_error = 0.03;
   /// A floor on each observation's error (what the model leaves out), m/s^2.
   double min_sigma_mps2 = 0.002;
   /// The prior on the accelerometer's bias, m/s^2 per axis.
@@ -46,6 +51,9 @@ struct GravityObservation {
   /// The odometry's acceleration over the window, weighted as mean_force is.
   Eigen::Vector3d path_acceleration = Eigen::Vector3d::Zero();
   double sigma_rad = 1.0;  ///< the direction's standard deviation per axis, radians
+  /// The keyframes whose windows share these samples: sigma_rad is one window's error times
+  /// the square root of this (each counts for a share).
+  double shared = 1.0;
   size_t samples = 0;
 
   /// Up in the keyframe's frame for bias `bias` (not normalised).
@@ -71,5 +79,26 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
                                                      const std::vector<ImuSample>& samples,
                                                      const std::vector<int64_t>& keyframe_stamps_ns,
                                                      const GravitySettings& settings);
+
+/// How the accelerometer's up directions agree with the LiDAR's rotations.
+struct GravityAgreement {
+  size_t observations = 0;
+  /// One window's error as the observations' model says (their median), and as their scatter
+  /// about one common tilt and bias says (robust RMS per axis, pooled), radians.
+  double model_rad = 0.0;
+  double scatter_rad = 0.0;
+};
+
+/// Weighs `observations` by how they agree with each other through the rotations of the nodes
+/// `R_map_node` (the LiDAR's, which tilt from keyframe to keyframe within a few thousandths of
+/// a degree): one common tilt and bias are fitted with the rotations held, and what scatters
+/// about them is the observations' real error. Beyond the accelerometer's noise that is the
+/// odometry's acceleration over the window, whose positions err together over seconds (a
+/// centimetre's wander over a 4 s window is 0.05 deg), not as the white jitter the model
+/// assumes. Each sigma is raised to the scatter (never lowered), so that the graph neither
+/// bends the LiDAR's relative tilts to that error nor trusts the map's tilt beyond it.
+GravityAgreement weigh_gravity_against_lidar(std::vector<GravityObservation>* observations,
+                                             const std::vector<Eigen::Matrix3d>& R_map_node,
+                                             double bias_prior_mps2);
 
 }  // namespace featsense::slam::loops

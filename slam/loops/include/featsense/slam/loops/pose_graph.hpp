@@ -81,6 +81,7 @@ struct PoseGraphSummary {
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   /// How the gyroscope's turns and the LiDAR's agreed (filled by LoopCloser::finish).
   TurnAgreement turn_agreement;
+  GravityAgreement gravity_agreement;
 };
 
 class PoseGraph {
