@@ -155,7 +155,9 @@ nlohmann::json localize_report_json(const config::Config& config, const Localize
                    {"rejected", c.search_rejected},
                    {"layout_ms", c.layout_ms},
                    {"layout_search_ms", bench::timing_json(c.layout_search_ms)},
-                   {"layout_bytes", c.layout_bytes}};
+                   {"layout_bytes", c.layout_bytes},
+                   {"keyframe_points_ms", c.keyframe_points_ms},
+                   {"keyframe_points_bytes", c.keyframe_points_bytes}};
   nlohmann::json events = nlohmann::json::array();
   size_t event_count = 0;
   for (size_t i = 0; i < run.scans.size(); ++i) {

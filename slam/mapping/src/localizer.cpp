@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <list>
+#include <memory>
 #include <stdexcept>
 #include <utility>
 
@@ -18,6 +20,7 @@
 #include "featsense/slam/trajectory/gyro_rotation.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "featsense/slam/trajectory/sweep_motion.hpp"
+#include "keyframe_points.hpp"
 #include "map_surface.hpp"
 #include "map_targets.hpp"
 #include "place_correlation.hpp"
@@ -82,6 +85,9 @@ std::string metres_text(double m) {
 
 /// Too few points to say anything: neither a fit nor a contradiction.
 constexpr size_t kMinPoints = 30;
+/// The map keyframes' points where the surface has none: one kept per voxel this wide (the
+/// keyframes' own clouds are thinned to 0.4 m).
+constexpr double kKeyframePointVoxel = 0.4;
 /// A surface is upright (a wall, a post) where its normal's vertical part is at most this.
 constexpr double kUprightMaxNormalZ = 0.5;
 
@@ -149,8 +155,22 @@ struct Localizer::State {
         layout);
   }
 
-  /// The surface around `position` for checking places: kept for the next keyframes, which
-  /// propose the same places.
+  /// The map keyframes' points for checking places beyond the surface, made the first time
+  /// (none where the settings say so).
+  const KeyframePoints* beyond_surface() {
+    if (!settings.search_keyframe_points) return nullptr;
+    if (!keyframe_points) {
+      const auto start = Clock::now();
+      keyframe_points =
+          std::make_unique<const KeyframePoints>(saved.keyframes, kKeyframePointVoxel);
+      counts.keyframe_points_ms = ms_since(start);
+      counts.keyframe_points_bytes = keyframe_points->bytes();
+    }
+    return keyframe_points.get();
+  }
+
+  /// The surface around `position` for checking places (with the keyframes' points beyond
+  /// it): kept for the next keyframes, which propose the same places.
   std::shared_ptr<const MapTarget> search_target(const Eigen::Vector3d& position) {
     const double cell_m = 0.25 * settings.search_radius_m;
     const std::array<int64_t, 2> key = {static_cast<int64_t>(std::floor(position.x() / cell_m)),
@@ -166,7 +186,7 @@ struct Localizer::State {
     std::shared_ptr<const MapTarget> target = build_map_target(
         surface, centre, settings.search_radius_m + cell_m, settings.search_voxel_sizes_m,
         settings.vgicp.fitness_voxel_m, settings.vgicp.fitness_voxel_m,
-        settings.search_reach_m > 0.0 ? kUprightMaxNormalZ : -1.0);
+        settings.search_reach_m > 0.0 ? kUprightMaxNormalZ : -1.0, beyond_surface());
     search_targets.emplace_front(key, target);
     if (search_targets.size() > settings.search_targets_kept) search_targets.pop_back();
     return target;
@@ -479,6 +499,9 @@ struct Localizer::State {
   config::Config config;
   LocalizerSettings settings;
   SavedMap saved;
+  /// The map keyframes' points, for checking places where the surface has nothing: made at
+  /// the first search.
+  std::unique_ptr<const KeyframePoints> keyframe_points;
   MapSurface surface;
   MapTargets targets;
   std::optional<Eigen::Isometry3d> initial_pose;

@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -12,9 +13,13 @@
 #include <vector>
 
 #include "background_thread.hpp"
+#include "featsense/slam/refine/gaussian_cloud.hpp"
 
 namespace featsense::mapping {
 namespace {
+
+/// The neighbours whose spread is a keyframe point's covariance.
+constexpr int kKeyframeNeighbours = 10;
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -96,7 +101,8 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
                                                   const Eigen::Vector3d& centre, double radius_m,
                                                   const std::vector<double>& voxel_sizes_m,
                                                   double fitness_voxel_m, double block_m,
-                                                  double upright_max_normal_z) {
+                                                  double upright_max_normal_z,
+                                                  const KeyframePoints* beyond) {
   const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m);
   const std::vector<std::shared_ptr<const ChunkSurface>> surfaces =
       surface.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
@@ -113,6 +119,36 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
       parts.push_back(to_voxel_gaussian(cell));
     }
     for (const std::array<int32_t, 3>& block : chunk->observed_blocks) {
+      observed.insert(grid_key(block));
+      if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
+        observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
+                                      static_cast<float>((block[1] + 0.5) * block_m));
+    }
+  }
+  if (beyond != nullptr) {
+    // Where the surface observed nothing, the keyframes' points, each with the covariance of
+    // its neighbours: a wall the mapping run saw from afar. Their blocks count as observed
+    // where they hold one (free space there was not observed).
+    const auto block_of = [block_m](const Eigen::Vector3f& p) {
+      return std::array<int32_t, 3>{static_cast<int32_t>(std::floor(p.x() / block_m)),
+                                    static_cast<int32_t>(std::floor(p.y() / block_m)),
+                                    static_cast<int32_t>(std::floor(p.z() / block_m))};
+    };
+    std::vector<Eigen::Vector3f> outside;
+    for (const Eigen::Vector3f& p : beyond->near(centre, radius_m))
+      if (observed.count(grid_key(block_of(p))) == 0) outside.push_back(p);
+    const slam::refine::GaussianCloud cloud =
+        slam::refine::with_covariances(outside, kKeyframeNeighbours);
+    std::vector<std::array<int32_t, 3>> seen;
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      slam::refine::VoxelGaussian part;
+      part.mean = cloud.points[i];
+      part.covariance = cloud.covariances[i];
+      part.points = 1;
+      parts.push_back(part);
+      seen.push_back(block_of(cloud.points[i].cast<float>()));
+    }
+    for (const std::array<int32_t, 3>& block : seen) {
       observed.insert(grid_key(block));
       if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
         observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "featsense/slam/refine/vgicp.hpp"
+#include "keyframe_points.hpp"
 #include "map_surface.hpp"
 
 namespace featsense::mapping {
@@ -65,11 +66,16 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
 /// `voxel_sizes_m` (multiples of the surface's cells) and the fit's voxels of `fitness_voxel_m`,
 /// the observed blocks of `block_m`, and its upright cells where `upright_max_normal_z` >= 0.
 /// Reads what the surface has not cached.
+/// Where `beyond` is given, its points in blocks the surface did not observe join the target
+/// (each with its neighbours' covariance) and their blocks count as observed: a target for
+/// checking a place found from scratch, not for tracking (they are less accurate than the
+/// surface: a keyframe's heading error times the range they were seen at).
 std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
                                                   const Eigen::Vector3d& centre, double radius_m,
                                                   const std::vector<double>& voxel_sizes_m,
                                                   double fitness_voxel_m, double block_m,
-                                                  double upright_max_normal_z = -1.0);
+                                                  double upright_max_normal_z = -1.0,
+                                                  const KeyframePoints* beyond = nullptr);
 
 struct MapTargetCounts {
   size_t built = 0;

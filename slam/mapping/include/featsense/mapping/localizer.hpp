@@ -108,6 +108,13 @@ struct LocalizerSettings {
   /// metres from the nearest keyframe, is proposed no place near it by a descriptor.
   /// 0: descriptors alone.
   size_t search_layout_places = 4;
+  /// A place found from scratch is checked against the map keyframes' points too where the
+  /// map's surface has nothing (it holds what lay within the local map around the path, the
+  /// keyframes what the sensor saw out to its range): a sensor that starts on a street the
+  /// mapping run looked down from afar is found there, then confirmed on the surface by the
+  /// tracking, which uses the surface alone (the points far from their keyframe are a few
+  /// centimetres less sure).
+  bool search_keyframe_points = true;
 
   static slam::refine::VgicpSettings tracking_vgicp();
 };
@@ -173,6 +180,10 @@ struct LocalizerCounts {
   double layout_ms = 0.0;
   size_t layout_bytes = 0;
   std::vector<double> layout_search_ms;  ///< per search keyframe
+  /// The map keyframes' points beyond the surface (the search's): the time to gather them
+  /// and their size.
+  double keyframe_points_ms = 0.0;
+  size_t keyframe_points_bytes = 0;
   size_t map_keyframes = 0;
   size_t map_chunks = 0;
   /// The map's surface: chunks read, reused, the cache's bytes.
