@@ -10,8 +10,8 @@
 namespace featsense::mapping {
 namespace {
 
-/// A wall along x at y = 30.2 in the map (mid-voxel), 0.1 m apart, as a keyframe at `T_map_sensor` sees it
-/// (its points in its own frame).
+/// A wall along x at y = 30.2 in the map (mid-voxel), 0.1 m apart, as a keyframe at `T_map_sensor`
+/// sees it (its points in its own frame).
 slam::loops::MapKeyframe seeing_the_wall(const Eigen::Isometry3d& T_map_sensor) {
   std::vector<Eigen::Vector3f> points;
   for (double x = -20.0; x <= 20.0; x += 0.1)

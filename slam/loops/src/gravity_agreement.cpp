@@ -6,14 +6,13 @@
 #include <vector>
 
 #include "featsense/slam/loops/gravity_reference.hpp"
+#include "robust_spread.hpp"
 
 namespace featsense::slam::loops {
 namespace {
 
 /// Fewer observations than this tell too little about their scatter: left as modelled.
 constexpr size_t kMinObservationsToWeigh = 10;
-/// The median of chi^2 with one degree of freedom.
-constexpr double kMedianChiSquared1 = 0.4549;
 
 }  // namespace
 
@@ -63,14 +62,10 @@ GravityAgreement weigh_gravity_against_lidar(std::vector<GravityObservation>* ob
     squares.push_back(e.x() * e.x());
     squares.push_back(e.y() * e.y());
   }
-  const auto middle = squares.begin() + static_cast<std::ptrdiff_t>(squares.size() / 2);
-  std::nth_element(squares.begin(), middle, squares.end());
   agreement.observations = n;
-  agreement.scatter_rad = std::sqrt(*middle / kMedianChiSquared1);
+  agreement.scatter_rad = std::sqrt(robust_variance(squares));
   std::vector<double> sorted_sigma = window_sigma;
-  std::nth_element(sorted_sigma.begin(), sorted_sigma.begin() + static_cast<std::ptrdiff_t>(n / 2),
-                   sorted_sigma.end());
-  agreement.model_rad = sorted_sigma[n / 2];
+  agreement.model_rad = upper_median(sorted_sigma);
   for (size_t i = 0; i < n; ++i) {
     GravityObservation& o = (*observations)[i];
     o.sigma_rad =

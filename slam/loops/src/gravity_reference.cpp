@@ -236,7 +236,7 @@ std::vector<GravityObservation> gravity_observations(const std::vector<int64_t>&
     const double odometry = settings.odometry_acceleration_error * o.path_acceleration.norm();
     o.sigma_rad = std::sqrt(accel * accel + positions * positions + odometry * odometry +
                             settings.min_sigma_mps2 * settings.min_sigma_mps2) /
-                  up * std::sqrt(std::max(1.0, shared));
+                  up * std::sqrt(o.shared);
     out.push_back(o);
   }
   return out;

@@ -11,6 +11,7 @@
 
 #include "featsense/slam/loops/gravity_reference.hpp"
 #include "featsense/slam/trajectory/gyro_rotation.hpp"
+#include "robust_spread.hpp"
 
 namespace featsense::slam::loops {
 namespace {
@@ -19,8 +20,6 @@ double seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
 /// Fewer edges than this tell too little about the two sensors' agreement: left as modelled.
 constexpr size_t kMinEdgesToWeigh = 10;
-/// The median of chi^2 with one degree of freedom.
-constexpr double kMedianChiSquared1 = 0.4549;
 /// The LiDAR's error is taken as at least this share of the sigma the graph gives it.
 constexpr double kLidarFloorShare = 0.1;
 /// A disagreement beyond this many times what the two claim together is not noise.
@@ -109,9 +108,7 @@ TurnAgreement weigh_against_lidar(std::vector<GyroObservation>* turns,
       const double e = misfit[i](axis) + ((*turns)[i].bias_jacobian * agreement.bias_radps)(axis);
       squares[i] = e * e;
     }
-    std::nth_element(squares.begin(), squares.begin() + static_cast<std::ptrdiff_t>(n / 2),
-                     squares.end());
-    const double variance = squares[n / 2] / kMedianChiSquared1;
+    const double variance = robust_variance(squares);
     agreement.disagreement_rad(axis) = std::sqrt(variance);
     // The LiDAR's error: what the gyroscope's noise leaves, at least a tenth of the graph's.
     const double floor = kLidarFloorShare * std::sqrt(claimed2(axis));

@@ -7,16 +7,6 @@
 #include "surface_cells.hpp"
 
 namespace featsense::mapping {
-namespace {
-
-std::array<int32_t, 3> cell_of(const Eigen::Vector3f& p, double size_m) {
-  return {static_cast<int32_t>(std::floor(p.x() / size_m)),
-          static_cast<int32_t>(std::floor(p.y() / size_m)),
-          static_cast<int32_t>(std::floor(p.z() / size_m))};
-}
-
-}  // namespace
-
 KeyframePoints::KeyframePoints(const std::vector<slam::loops::MapKeyframe>& keyframes,
                                double voxel_m, double tile_m)
     : tile_m_(tile_m) {
@@ -25,8 +15,9 @@ KeyframePoints::KeyframePoints(const std::vector<slam::loops::MapKeyframe>& keyf
     const Eigen::Isometry3f T = keyframe.T_map_sensor.cast<float>();
     for (const Eigen::Vector3f& p : keyframe.cloud.points()) {
       const Eigen::Vector3f q = T * p;
-      if (!q.allFinite() || !taken.insert(grid_key(cell_of(q, voxel_m))).second) continue;
-      std::array<int32_t, 3> tile = cell_of(q, tile_m_);
+      if (!q.allFinite() || !taken.insert(grid_key(grid_index(q.cast<double>(), voxel_m))).second)
+        continue;
+      std::array<int32_t, 3> tile = grid_index(q.cast<double>(), tile_m_);
       tile[2] = 0;
       tiles_[grid_key(tile)].push_back(q);
       ++size_;

@@ -40,10 +40,7 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
   std::vector<const slam::refine::VoxelGaussian*> found;
   for (const Eigen::Vector3d& p : cloud.points) {
     const Eigen::Vector3d q = T * p;
-    const std::array<int32_t, 3> block = {static_cast<int32_t>(std::floor(q.x() / target.block_m)),
-                                          static_cast<int32_t>(std::floor(q.y() / target.block_m)),
-                                          static_cast<int32_t>(std::floor(q.z() / target.block_m))};
-    if (target.observed.count(grid_key(block)) == 0) continue;
+    if (target.observed.count(grid_key(grid_index(q, target.block_m))) == 0) continue;
     ++fit.observed;
     target.vgicp.fitness.near(q, found);
     if (found.empty()) continue;
@@ -112,47 +109,37 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
   const bool with_upright = upright_max_normal_z >= 0.0;
   std::unordered_set<uint64_t> columns;
   std::vector<Eigen::Vector2f> observed_columns;
+  const auto observe = [&](const std::array<int32_t, 3>& block) {
+    observed.insert(grid_key(block));
+    if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
+      observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
+                                    static_cast<float>((block[1] + 0.5) * block_m));
+  };
   const double radius2 = radius_m * radius_m;
   for (const std::shared_ptr<const ChunkSurface>& chunk : surfaces) {
     for (const SurfaceCell& cell : chunk->cells) {
       if ((cell.mean.cast<double>() - centre).head<2>().squaredNorm() > radius2) continue;
       parts.push_back(to_voxel_gaussian(cell));
     }
-    for (const std::array<int32_t, 3>& block : chunk->observed_blocks) {
-      observed.insert(grid_key(block));
-      if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
-        observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
-                                      static_cast<float>((block[1] + 0.5) * block_m));
-    }
+    for (const std::array<int32_t, 3>& block : chunk->observed_blocks) observe(block);
   }
   if (beyond != nullptr) {
     // Where the surface observed nothing, the keyframes' points, each with the covariance of
     // its neighbours: a wall the mapping run saw from afar. Their blocks count as observed
     // where they hold one (free space there was not observed).
-    const auto block_of = [block_m](const Eigen::Vector3f& p) {
-      return std::array<int32_t, 3>{static_cast<int32_t>(std::floor(p.x() / block_m)),
-                                    static_cast<int32_t>(std::floor(p.y() / block_m)),
-                                    static_cast<int32_t>(std::floor(p.z() / block_m))};
-    };
     std::vector<Eigen::Vector3f> outside;
     for (const Eigen::Vector3f& p : beyond->near(centre, radius_m))
-      if (observed.count(grid_key(block_of(p))) == 0) outside.push_back(p);
+      if (observed.count(grid_key(grid_index(p.cast<double>(), block_m))) == 0)
+        outside.push_back(p);
     const slam::refine::GaussianCloud cloud =
         slam::refine::with_covariances(outside, kKeyframeNeighbours);
-    std::vector<std::array<int32_t, 3>> seen;
     for (size_t i = 0; i < cloud.size(); ++i) {
       slam::refine::VoxelGaussian part;
       part.mean = cloud.points[i];
       part.covariance = cloud.covariances[i];
       part.points = 1;
       parts.push_back(part);
-      seen.push_back(block_of(cloud.points[i].cast<float>()));
-    }
-    for (const std::array<int32_t, 3>& block : seen) {
-      observed.insert(grid_key(block));
-      if (with_upright && columns.insert(grid_key({block[0], block[1], 0})).second)
-        observed_columns.emplace_back(static_cast<float>((block[0] + 0.5) * block_m),
-                                      static_cast<float>((block[1] + 0.5) * block_m));
+      observe(grid_index(cloud.points[i], block_m));
     }
   }
   std::vector<slam::refine::VoxelGaussians> levels;

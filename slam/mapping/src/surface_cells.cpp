@@ -129,10 +129,7 @@ ChunkSurface chunk_surface(const storage::ChunkKey& key, const storage::Chunk& c
           Eigen::Vector3d voxel(x + 0.5, y + 0.5, z + 0.5);
           voxel[axis] += t;
           const Eigen::Vector3d p = (origin + voxel) * settings.voxel_m;
-          const std::array<int32_t, 3> index = {
-              static_cast<int32_t>(std::floor(p.x() / settings.cell_m)),
-              static_cast<int32_t>(std::floor(p.y() / settings.cell_m)),
-              static_cast<int32_t>(std::floor(p.z() / settings.cell_m))};
+          const std::array<int32_t, 3> index = grid_index(p, settings.cell_m);
           auto& [cell_index, sum] = cells[grid_key(index)];
           cell_index = index;
           sum.points += p;
@@ -178,6 +175,12 @@ ChunkSurface chunk_surface(const storage::ChunkKey& key, const storage::Chunk& c
     }
   }
   return surface;
+}
+
+std::array<int32_t, 3> grid_index(const Eigen::Vector3d& p, double edge_m) {
+  return {static_cast<int32_t>(std::floor(p.x() / edge_m)),
+          static_cast<int32_t>(std::floor(p.y() / edge_m)),
+          static_cast<int32_t>(std::floor(p.z() / edge_m))};
 }
 
 slam::refine::VoxelGaussian to_voxel_gaussian(const SurfaceCell& cell) {

@@ -53,6 +53,9 @@ ChunkSurface chunk_surface(const storage::ChunkKey& key, const storage::Chunk& c
 /// A key of a cell or block index, unique within +/- 2^20 of the origin.
 uint64_t grid_key(const std::array<int32_t, 3>& index);
 
+/// The index of the cell or block `edge_m` across that holds `p`.
+std::array<int32_t, 3> grid_index(const Eigen::Vector3d& p, double edge_m);
+
 /// A cell as voxelized GICP sums it (VoxelGaussians' parts).
 slam::refine::VoxelGaussian to_voxel_gaussian(const SurfaceCell& cell);
 
