@@ -29,6 +29,7 @@ nlohmann::json odometry_json(const slam::odometry::OdometryCounts& counts, bool 
   return {{"scans", counts.scans},
           {"degenerate_scans", counts.degenerate_scans},
           {"failed_scans", counts.failed_scans},
+          {"turn_search", {{"searched", counts.turn_searches}, {"found", counts.turns_found}}},
           {"time_jumps", counts.time_jumps},
           {"standing",
            {{"stands", counts.stands},

@@ -19,6 +19,8 @@ void expect_same(const OdometrySettings& a, const OdometrySettings& b) {
   EXPECT_EQ(a.degeneracy_threshold, b.degeneracy_threshold);
   EXPECT_EQ(a.max_speed_m_s, b.max_speed_m_s);
   EXPECT_EQ(a.max_turn_rate_rad_s, b.max_turn_rate_rad_s);
+  EXPECT_EQ(a.poor_fit_ratio, b.poor_fit_ratio);
+  EXPECT_EQ(a.turn_search_deg, b.turn_search_deg);
   EXPECT_EQ(a.deskew, b.deskew);
   EXPECT_EQ(a.hold_still, b.hold_still);
 }
@@ -39,6 +41,8 @@ TEST(OdometrySettings, EveryKeyReachesItsSetting) {
   c.degeneracy_threshold = 0.05;
   c.max_speed_m_s = 20.0;
   c.max_turn_rate_rad_s = 2.0;
+  c.poor_fit_ratio = 3.0;
+  c.turn_search_deg = 12.0;
   c.deskew = false;
   c.hold_still = false;
 
@@ -52,6 +56,8 @@ TEST(OdometrySettings, EveryKeyReachesItsSetting) {
   expected.degeneracy_threshold = 0.05;
   expected.max_speed_m_s = 20.0;
   expected.max_turn_rate_rad_s = 2.0;
+  expected.poor_fit_ratio = 3.0;
+  expected.turn_search_deg = 12.0;
   expected.deskew = false;
   expected.hold_still = false;
   expect_same(from_config(config), expected);

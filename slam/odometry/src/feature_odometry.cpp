@@ -10,8 +10,10 @@
 #include "featsense/slam/odometry/stand_detector.hpp"
 #include "featsense/slam/trajectory/gyro_rotation.hpp"
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
+#include "recent_fits.hpp"
 #include "scan_to_map.hpp"
 #include "timed_features.hpp"
+#include "turn_search.hpp"
 
 namespace featsense::slam::odometry {
 namespace {
@@ -31,6 +33,10 @@ constexpr double kStillSearch = 25.0;
 /// noise bound is wide enough to take a walk along a corridor for a stand.
 constexpr double kStandObservability = 0.02;
 
+/// A fit within this is exact to every LiDAR's noise (real and simulated scans fit to 2-4 mm,
+/// wrong minima to 7-20 mm): never searched again, however it compares with the last ones.
+constexpr double kExactFitM = 1e-3;
+
 bool observes_every_direction(const OdometryResult& r) {
   return r.diagnostics.converged && !r.diagnostics.degenerate &&
          r.information_eigenvalues.minCoeff() >= kStandObservability;
@@ -46,7 +52,8 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 FeatureOdometry::FeatureOdometry(const OdometrySettings& settings)
     : settings_(settings),
       map_(new_map()),
-      stand_(settings.stand_enter_scans, settings.stand_leave_scans) {}
+      stand_(settings.stand_enter_scans, settings.stand_leave_scans),
+      recent_fits_(std::make_unique<RecentFits>()) {}
 
 FeatureOdometry::~FeatureOdometry() = default;
 
@@ -87,6 +94,7 @@ OdometryResult FeatureOdometry::register_scan(const FeatureSet& features,
     result.reason = "first scan: the map starts here";
   } else {
     pose = register_to_map(*map_, raw, start, settings_, result);
+    pose = search_if_poor(raw, start, pose, result);
     registered = true;
   }
 
@@ -139,6 +147,30 @@ Eigen::Isometry3d FeatureOdometry::predicted_motion(int64_t stamp_ns, double ela
       gyro_rotation(last_imu_, imu, last_stamp_ns_, stamp_ns);
   if (!turn_before || !turn_now) return constant_velocity;
   return gyro_corrected_prediction(constant_velocity, last_motion_, *turn_before, *turn_now, ratio);
+}
+
+Eigen::Isometry3d FeatureOdometry::search_if_poor(const TimedFeatures& raw,
+                                                  const RegistrationStart& start,
+                                                  const Eigen::Isometry3d& pose,
+                                                  OdometryResult& result) {
+  Eigen::Isometry3d kept = pose;
+  const double typical_m = recent_fits_->median();
+  const double poor_m = std::max(settings_.poor_fit_ratio * typical_m, kExactFitM);
+  const bool poor = result.diagnostics.converged
+                        ? result.diagnostics.fitness_m > poor_m
+                        : result.edge_correspondences + result.surface_correspondences > 0;
+  if (settings_.turn_search_deg > 0.0 && typical_m > 0.0 && poor) {
+    const OdometryResult first = result;
+    result.turn_searched = true;
+    if (const auto found =
+            register_from_turned_starts(*map_, raw, start, settings_, first, poor_m, result)) {
+      kept = *found;
+      result.turn_searched = true;
+      result.turn_found = true;
+    }
+  }
+  if (result.diagnostics.converged) recent_fits_->add(result.diagnostics.fitness_m);
+  return kept;
 }
 
 FeatureOdometry::StillTest FeatureOdometry::still_test(const TimedFeatures& raw,

@@ -56,6 +56,8 @@ class FeatureOdometryLocator final : public OdometryLocator {
     counts_.features_sum += static_cast<double>(found.size());
     if (found.intensity_confirmed) ++counts_.intensity_confirmed_scans;
     if (result.diagnostics.degenerate) ++counts_.degenerate_scans;
+    if (result.turn_searched) ++counts_.turn_searches;
+    if (result.turn_found) ++counts_.turns_found;
     const std::string jump = time_jump(result.elapsed_s, counts_.scans > 1, scan.sequence);
     if (!result.diagnostics.converged && counts_.scans > 1) {
       ++counts_.failed_scans;

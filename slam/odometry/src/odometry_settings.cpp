@@ -15,6 +15,8 @@ OdometrySettings from_config(const config::Config& config) {
   s.degeneracy_threshold = c.degeneracy_threshold;
   s.max_speed_m_s = c.max_speed_m_s;
   s.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
+  s.poor_fit_ratio = c.poor_fit_ratio;
+  s.turn_search_deg = c.turn_search_deg;
   s.deskew = c.deskew;
   s.hold_still = c.hold_still;
   return s;

@@ -105,6 +105,8 @@ struct OdometryConfig {
   double degeneracy_threshold = 0.002;         ///< see default.yaml
   double max_speed_m_s = 30.0;  ///< larger corrections of the prediction are divergence
   double max_turn_rate_rad_s = 3.0;
+  double poor_fit_ratio = 2.0;   ///< see default.yaml
+  double turn_search_deg = 9.0;  ///< see default.yaml
 };
 
 struct RefineConfig {

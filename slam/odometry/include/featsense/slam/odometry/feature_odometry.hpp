@@ -18,6 +18,7 @@
 namespace featsense::slam::odometry {
 
 class LocalFeatureMap;
+class RecentFits;
 struct TimedFeatures;
 struct RegistrationStart;
 
@@ -32,7 +33,10 @@ class FeatureOdometry {
   /// the identity. An empty scan, too few correspondences or a diverging solve (a correction
   /// of the prediction beyond max_speed / max_turn_rate over the elapsed time, or a cost
   /// above the prediction's) give the prediction, with converged=false and the reason.
-  /// In degenerate directions the pose keeps the prediction. Every scan with features is
+  /// In degenerate directions the pose keeps the prediction. A registration that fits far
+  /// worse than the last scans' (odometry.poor_fit_ratio), or does not converge, is registered
+  /// again from the prediction turned about the vertical (odometry.turn_search), and the
+  /// best clearly better fit kept (turn_searched / turn_found). Every scan with features is
   /// then added to the map at the pose given. The second scan restarts the map with the
   /// first one deskewed, once the motion is known, and is registered again.
   /// With hold_still, a sensor that stands still (StandDetector) keeps the stand's pose and
@@ -59,6 +63,10 @@ class FeatureOdometry {
   /// rotation the gyroscope's turn where the samples cover this period and the last.
   Eigen::Isometry3d predicted_motion(int64_t stamp_ns, double elapsed_s,
                                      const std::vector<ImuSample>& imu) const;
+  /// A registration that fits far worse than the last scans' searched again from turned
+  /// starts (turn_search.hpp); the pose to keep.
+  Eigen::Isometry3d search_if_poor(const TimedFeatures& raw, const RegistrationStart& start,
+                                   const Eigen::Isometry3d& pose, OdometryResult& result);
   void hold(const Eigen::Isometry3d& pose, int64_t stamp_ns, OdometryResult& result);
   void add_to_map(const TimedFeatures& raw, const SweepMotion& sweep, const Eigen::Isometry3d& pose,
                   int64_t stamp_ns, OdometryResult& result);
@@ -80,6 +88,8 @@ class FeatureOdometry {
   /// The last pose's precision (OdometryResult::precision), for the stand detector.
   Eigen::Matrix<double, 6, 6> last_precision_ = Eigen::Matrix<double, 6, 6>::Zero();
   StandDetector stand_;
+  /// The fits of the last registrations, against which a poor one is told.
+  std::unique_ptr<RecentFits> recent_fits_;
 };
 
 }  // namespace featsense::slam::odometry

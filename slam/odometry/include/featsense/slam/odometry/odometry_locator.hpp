@@ -19,6 +19,8 @@ struct OdometryCounts {
   size_t scans = 0;
   size_t degenerate_scans = 0;  ///< a direction of motion held at the prediction
   size_t failed_scans = 0;      ///< the pose is the prediction (the reason is logged)
+  size_t turn_searches = 0;     ///< poor fits searched again from turned starts
+  size_t turns_found = 0;       ///< ... where a turned start gave the pose
   size_t time_jumps = 0;        ///< frames dropped, or a stamp that did not grow
   size_t stands = 0;            ///< times the sensor stood still (odometry.hold_still)
   size_t standing_scans = 0;    ///< scans whose pose was held while it stood

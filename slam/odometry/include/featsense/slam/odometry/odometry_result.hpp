@@ -44,6 +44,10 @@ struct OdometryResult {
   /// The scan was taken while the sensor stood still: its pose is the stand's (see
   /// StandDetector), and it did not go into the local map.
   bool standing = false;
+  /// The registration fitted far worse than the last scans' (odometry.poor_fit_ratio) and was
+  /// searched again from turned starts (odometry.turn_search); found: one of them gave the pose.
+  bool turn_searched = false;
+  bool turn_found = false;
 
   size_t scan_edges = 0;               ///< the scan's edges after the voxel filter
   size_t scan_surfaces = 0;            ///< the scan's surfaces after the voxel filter

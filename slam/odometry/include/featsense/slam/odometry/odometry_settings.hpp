@@ -28,6 +28,10 @@ struct OdometrySettings {
   double degeneracy_threshold = detail::kDefaultOdometry.degeneracy_threshold;
   double max_speed_m_s = detail::kDefaultOdometry.max_speed_m_s;
   double max_turn_rate_rad_s = detail::kDefaultOdometry.max_turn_rate_rad_s;
+  /// A fit this many times the recent median is searched again from turned starts.
+  double poor_fit_ratio = detail::kDefaultOdometry.poor_fit_ratio;
+  /// The largest turn of the prediction that search tries, degrees; 0: no search.
+  double turn_search_deg = detail::kDefaultOdometry.turn_search_deg;
   /// Register the features deskewed to the scan's stamp with the motion being estimated
   /// (re-deskewed at every outer loop); false: as measured.
   bool deskew = detail::kDefaultOdometry.deskew;
