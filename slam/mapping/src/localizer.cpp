@@ -256,13 +256,15 @@ struct Localizer::State {
   /// `cloud` (deskewed, in the sensor's frame at the stamp) registered to `target` from
   /// `guess`, at each of its voxel sizes or at the finest alone, and judged.
   Fit fit_on(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
-             const Eigen::Isometry3d& guess, bool finest_only, size_t first_level = 0) const {
+             const Eigen::Isometry3d& guess, bool finest_only, size_t first_level = 0,
+             double robust_scale = 0.0) const {
     Fit fit;
     fit.points = cloud.size();
-    fit.result = finest_only
-                     ? slam::refine::align_to_voxels(target.vgicp.levels.back(), cloud, guess,
-                                                     settings.vgicp)
-                     : slam::refine::align(target.vgicp, cloud, guess, settings.vgicp, first_level);
+    slam::refine::VgicpSettings vgicp = settings.vgicp;
+    vgicp.robust_scale = robust_scale;
+    fit.result =
+        finest_only ? slam::refine::align_to_voxels(target.vgicp.levels.back(), cloud, guess, vgicp)
+                    : slam::refine::align(target.vgicp, cloud, guess, vgicp, first_level);
     judge(target, cloud, fit);
     return fit;
   }
@@ -428,13 +430,18 @@ struct Localizer::State {
       const std::shared_ptr<const MapTarget> target = targets.around(predicted.translation());
       // Tracked without a break, the prediction is good to centimetres: the coarsest voxels
       // add nothing to the finer ones.
-      const size_t first_level =
-          status == LocalizeStatus::kLocalized && good_in_row > 0 ? settings.steady_first_level : 0;
-      fit = fit_on(*target, deskewed(cloud, sweep_to(predicted)), predicted, false, first_level);
+      const bool steady = status == LocalizeStatus::kLocalized && good_in_row > 0;
+      const size_t first_level = steady ? settings.steady_first_level : 0;
+      // ... and what the map does not hold lets go of it (tracking_robust_scale); from a
+      // prediction of the odometry's or a place just found, least squares: a kernel would let
+      // a wrong place fit the part of the scan that matches it (a room turned by 90 deg).
+      const double robust_scale = steady ? settings.tracking_robust_scale : 0.0;
+      fit = fit_on(*target, deskewed(cloud, sweep_to(predicted)), predicted, false, first_level,
+                   robust_scale);
       // Deskewed again with the motion found, and registered again from there; where that
       // fits worse than the first (it went astray), the first stands.
       const Eigen::Isometry3d found = fit.result.T_target_source;
-      Fit again = fit_on(*target, deskewed(cloud, sweep_to(found)), found, true);
+      Fit again = fit_on(*target, deskewed(cloud, sweep_to(found)), found, true, 0, robust_scale);
       if (again.good || !fit.good) fit = std::move(again);
     } else {
       fit.result.T_target_source = predicted;

@@ -110,7 +110,9 @@ std::vector<Correspondence> correspond(const VoxelGaussians& target, const Gauss
 
 /// The cost of the fixed terms at T and, when `derivatives`, its gradient and Hessian.
 VgicpLinearization evaluate(const GaussianCloud& source, const std::vector<Correspondence>& terms,
-                            const Eigen::Isometry3d& T, bool derivatives) {
+                            const Eigen::Isometry3d& T, bool derivatives,
+                            double robust_scale = 0.0) {
+  const double k2 = robust_scale * robust_scale;
   const Eigen::Matrix3d R = T.rotation();
   return tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, terms.size(), 512), VgicpLinearization{},
@@ -128,9 +130,14 @@ VgicpLinearization evaluate(const GaussianCloud& source, const std::vector<Corre
           bool invertible = false;
           C.computeInverseAndDetWithCheck(W, determinant, invertible, 1e-12);
           if (!invertible || !(determinant > 0.0)) continue;
-          sum.cost += e.dot(W * e);
+          const double d2 = e.dot(W * e);
+          // Geman-McClure: rho(d2) = k2 d2 / (k2 + d2), its slope the term's weight
+          // (iteratively reweighted least squares).
+          const double weight = k2 > 0.0 ? (k2 / (k2 + d2)) * (k2 / (k2 + d2)) : 1.0;
+          sum.cost += k2 > 0.0 ? k2 * d2 / (k2 + d2) : d2;
           ++sum.terms;
           if (!derivatives) continue;
+          W *= weight;
           // e(step) = mu - (Exp(w) x + v) = e + [x]x w - v to first order.
           Eigen::Matrix<double, 3, 6> J;
           J.leftCols<3>() = skew(x);
@@ -166,10 +173,12 @@ struct Part {
 /// Hessian in the shared step (a part's step is its share of it).
 VgicpLinearization evaluate_parts(const std::vector<Part>& parts,
                                   const std::vector<std::vector<Correspondence>>& terms,
-                                  const std::vector<Eigen::Isometry3d>& poses, bool derivatives) {
+                                  const std::vector<Eigen::Isometry3d>& poses, bool derivatives,
+                                  double robust_scale) {
   VgicpLinearization sum;
   for (size_t i = 0; i < parts.size(); ++i) {
-    const VgicpLinearization part = evaluate(*parts[i].cloud, terms[i], poses[i], derivatives);
+    const VgicpLinearization part =
+        evaluate(*parts[i].cloud, terms[i], poses[i], derivatives, robust_scale);
     const double s = parts[i].share;
     sum.cost += part.cost;
     sum.terms += part.terms;
@@ -216,7 +225,7 @@ std::vector<Vector6d> solve_parts(const VoxelGaussians& target, std::vector<Part
     const PartTerms held = terms_at(target, parts);
     const std::vector<std::vector<Correspondence>>& terms = held.terms;
     const std::vector<Eigen::Isometry3d>& poses = held.poses;
-    const VgicpLinearization at = evaluate_parts(parts, terms, poses, true);
+    const VgicpLinearization at = evaluate_parts(parts, terms, poses, true, settings.robust_scale);
     if (at.terms < 6) break;  // too few correspondences to fix a pose
     bool accepted = false;
     bool settled = false;
@@ -228,7 +237,8 @@ std::vector<Vector6d> solve_parts(const VoxelGaussians& target, std::vector<Part
       step = damped.ldlt().solve(-at.gradient);
       if (!step.allFinite()) break;
       const std::vector<Eigen::Isometry3d> candidate = stepped(parts, step);
-      const VgicpLinearization next = evaluate_parts(parts, terms, candidate, false);
+      const VgicpLinearization next =
+          evaluate_parts(parts, terms, candidate, false, settings.robust_scale);
       if (next.cost <= at.cost) {
         // A step that lowers the cost by a millionth or less: the terms are at their minimum
         // (at fine voxels the points keep trading voxels by fractions of a millimetre).
@@ -363,7 +373,7 @@ namespace {
 void keep_weak_directions(const VoxelGaussians& finest, const std::vector<SharedSource>& sources,
                           double min_ratio, std::vector<Part>& parts, SharedVgicpResult& result) {
   const PartTerms held = terms_at(finest, parts);
-  const VgicpLinearization at = evaluate_parts(parts, held.terms, held.poses, true);
+  const VgicpLinearization at = evaluate_parts(parts, held.terms, held.poses, true, 0.0);
   // The turns' lever arm: the points' RMS distance from the centre of rotation (the origin).
   double squares = 0.0;
   size_t points = 0;

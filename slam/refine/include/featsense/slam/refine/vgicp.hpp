@@ -37,6 +37,11 @@ struct VgicpSettings {
   /// firmly as the best-constrained one keeps the guesses (weak_directions.hpp); 0 corrects
   /// every direction.
   double min_constraint_ratio = 0.0;
+  /// Geman-McClure's scale on each term's Mahalanobis distance: a term at distance d weighs
+  /// (k^2 / (k^2 + d^2))^2, so that points on what the target does not hold (a car moved
+  /// since the map was made) stop pulling; 0: every term counts in full (least squares). The
+  /// result's Hessian, and align_shared's weak directions, are least squares' either way.
+  double robust_scale = 0.0;
 };
 
 /// What a registration found, and how well: for the fitness check of the refinement and the
