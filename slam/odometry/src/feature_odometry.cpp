@@ -160,14 +160,10 @@ Eigen::Isometry3d FeatureOdometry::search_if_poor(const TimedFeatures& raw,
                         ? result.diagnostics.fitness_m > poor_m
                         : result.edge_correspondences + result.surface_correspondences > 0;
   if (settings_.turn_search_deg > 0.0 && typical_m > 0.0 && poor) {
-    const OdometryResult first = result;
+    const auto found = register_from_turned_starts(*map_, raw, start, settings_, poor_m, result);
+    if (found) kept = *found;
     result.turn_searched = true;
-    if (const auto found =
-            register_from_turned_starts(*map_, raw, start, settings_, first, poor_m, result)) {
-      kept = *found;
-      result.turn_searched = true;
-      result.turn_found = true;
-    }
+    result.turn_found = found.has_value();
   }
   if (result.diagnostics.converged) recent_fits_->add(result.diagnostics.fitness_m);
   return kept;

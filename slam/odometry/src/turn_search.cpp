@@ -35,8 +35,8 @@ OdometryResult before_registration(const OdometryResult& first) {
 
 std::optional<Eigen::Isometry3d> register_from_turned_starts(
     const LocalFeatureMap& map, const TimedFeatures& raw, const RegistrationStart& start,
-    const OdometrySettings& settings, const OdometryResult& first, double good_fit_m,
-    OdometryResult& result) {
+    const OdometrySettings& settings, double good_fit_m, OdometryResult& result) {
+  const OdometryResult first = result;
   const int steps = static_cast<int>(std::floor(settings.turn_search_deg / kTurnSearchStepDeg));
   std::optional<Eigen::Isometry3d> best;
   OdometryResult best_result;

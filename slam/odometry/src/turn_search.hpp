@@ -21,13 +21,13 @@ constexpr double kTurnSearchStepDeg = 3.0;
 
 /// Registers `raw` again from start.prediction turned about the map frame's z axis (through
 /// the predicted position) by +-kTurnSearchStepDeg, +-2 kTurnSearchStepDeg, ... up to
-/// settings.turn_search_deg. `first` is the registration from the prediction itself.
-/// Returns the pose of the best that converged with about as many correspondences as
-/// `first` and clearly fits better (at most `good_fit_m` where `first` did not converge),
-/// and sets `result` to it; nothing where none does.
+/// settings.turn_search_deg. `result` holds the registration from the prediction itself.
+/// Returns the pose of the best that converged with about as many correspondences as it
+/// and clearly fits better (at most `good_fit_m` where it did not converge), and sets
+/// `result` to that registration; nothing where none does (`result` then only counts the
+/// search's time).
 std::optional<Eigen::Isometry3d> register_from_turned_starts(
     const LocalFeatureMap& map, const TimedFeatures& raw, const RegistrationStart& start,
-    const OdometrySettings& settings, const OdometryResult& first, double good_fit_m,
-    OdometryResult& result);
+    const OdometrySettings& settings, double good_fit_m, OdometryResult& result);
 
 }  // namespace featsense::slam::odometry
