@@ -286,6 +286,29 @@ struct Localizer::State {
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
   }
 
+  /// What keeps `fit` from being good, the first of judge's tests it fails.
+  std::string shortfall(const Fit& fit) const {
+    char text[96];
+    const MapFit& m = fit.map;
+    if (m.observed < settings.min_observed_points) {
+      std::snprintf(text, sizeof text, "%zu of its points where the map observed anything",
+                    m.observed);
+    } else if (m.coverage < settings.min_coverage) {
+      std::snprintf(text, sizeof text, "%d %% of the scan where the map observed anything",
+                    static_cast<int>(100.0 * m.coverage));
+    } else if (m.position_sigma_m > settings.max_position_sigma_m ||
+               m.rotation_sigma_deg > settings.max_rotation_sigma_deg) {
+      std::snprintf(text, sizeof text, "held to %.0f mm, %.2f deg only",
+                    1000.0 * m.position_sigma_m, m.rotation_sigma_deg);
+    } else if (m.inlier_fraction < settings.min_inlier_fraction) {
+      std::snprintf(text, sizeof text, "%d %% of the scan on it",
+                    static_cast<int>(100.0 * m.inlier_fraction));
+    } else {
+      std::snprintf(text, sizeof text, "fitness %.1f mm", 1000.0 * m.fitness_m);
+    }
+    return text;
+  }
+
   void remember(int64_t stamp_ns, const Eigen::Isometry3d& T) {
     before_last = last;
     last = Pose{stamp_ns, T};
@@ -322,9 +345,13 @@ struct Localizer::State {
     // as a tracked scan would.
     if (!fit.good) {
       ++counts.unconfirmed_matches;
-      out.event = "a match with the map's keyframes that its surface does not confirm (" +
-                  std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +
-                  " % of the scan on it): searching on";
+      const Eigen::Vector3d at = fit.result.T_target_source.translation();
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    "a match with the map's keyframes at (%.1f, %.1f, %.1f) that its surface "
+                    "does not confirm (%s): searching on",
+                    at.x(), at.y(), at.z(), shortfall(fit).c_str());
+      out.event = text;
       // The relocalizer keeps a placement once made; a fresh one searches on, with the same
       // odometry.
       new_relocalizer();
