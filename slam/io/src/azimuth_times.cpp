@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "featsense/slam/upper_median.hpp"
 #include "point_validity.hpp"
 #include "ring_turns.hpp"
 
@@ -81,13 +82,6 @@ std::string percent(double share) {
   return text;
 }
 
-/// The median of `values` (reordered).
-double median_of(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 /// How far the rings begin before the seam, typically: the first ring's first returns may
 /// be missing, and then the seam lies where most rings begin (radians, >= 0).
 double rings_begin_before_seam_rad(const std::vector<double>& turned,
@@ -97,7 +91,7 @@ double rings_begin_before_seam_rad(const std::vector<double>& turned,
   for (size_t r = 0; r < starts.size(); ++r) {
     before.push_back(kTwoPi * static_cast<double>(r + 1) - turned[starts[r]]);
   }
-  return std::max(0.0, median_of(before));
+  return std::max(0.0, upper_median(before));
 }
 
 }  // namespace

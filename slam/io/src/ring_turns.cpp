@@ -6,6 +6,8 @@
 #include <cmath>
 #include <optional>
 
+#include "featsense/slam/upper_median.hpp"
+
 namespace featsense::slam {
 namespace {
 
@@ -37,18 +39,12 @@ struct Spread {
   double deviation = 0.0;  ///< median absolute deviation
 };
 
-double median_of(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 std::optional<Spread> spread_of(std::vector<double> values) {
   if (values.size() < kMinBesidePoints) return std::nullopt;
   Spread spread;
-  spread.median = median_of(values);
+  spread.median = upper_median(values);
   for (double& v : values) v = std::abs(v - spread.median);
-  spread.deviation = median_of(values);
+  spread.deviation = upper_median(values);
   return spread;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "featsense/slam/loops/trajectory_correction.hpp"
+#include "featsense/slam/upper_median.hpp"
 
 namespace featsense::slam::loops {
 namespace {
@@ -134,8 +135,7 @@ int64_t median_sample_period_ns(const std::vector<ImuSample>& samples) {
   std::vector<int64_t> spacing;
   for (size_t i = 1; i < samples.size(); ++i)
     spacing.push_back(samples[i].stamp_ns - samples[i - 1].stamp_ns);
-  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  return spacing[spacing.size() / 2];
+  return upper_median(spacing);
 }
 
 void append_in_time_order(std::vector<ImuSample>* log, const std::vector<ImuSample>& more) {

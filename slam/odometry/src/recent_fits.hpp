@@ -2,10 +2,11 @@
 /// The fits (mean correspondence distance) of the last registrations that converged: what a
 /// good fit looks like in the scene the sensor is in now, to tell a wrong minimum by.
 
-#include <algorithm>
 #include <cstddef>
 #include <deque>
 #include <vector>
+
+#include "featsense/slam/upper_median.hpp"
 
 namespace featsense::slam::odometry {
 
@@ -24,9 +25,8 @@ class RecentFits {
   /// The median of the fits kept; 0 until there are kEnough.
   double median() const {
     if (fits_.size() < kEnough) return 0.0;
-    std::vector<double> sorted(fits_.begin(), fits_.end());
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    return sorted[sorted.size() / 2];
+    std::vector<double> fits(fits_.begin(), fits_.end());
+    return upper_median(fits);
   }
 
  private:

@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "beam_origin.hpp"
+#include "featsense/slam/upper_median.hpp"
 #include "point_validity.hpp"
 
 namespace featsense::slam::cloud {
@@ -135,9 +136,7 @@ std::optional<double> row_elevation(const PointCloud& cloud, int width, int row,
     if (is_return(cloud.xyz[i])) scratch.push_back(elevation_of(cloud.xyz[i]));
   }
   if (scratch.empty()) return std::nullopt;
-  auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
-  std::nth_element(scratch.begin(), middle, scratch.end());
-  return *middle;
+  return upper_median(scratch);
 }
 
 bool row_has_data(const PointCloud& cloud, int width, int row) {
@@ -251,9 +250,7 @@ std::optional<double> azimuth_step(std::vector<double> azimuth_rad) {
     if (step > 1e-6) steps.push_back(step);
   }
   if (steps.empty()) return std::nullopt;
-  auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
-  std::nth_element(steps.begin(), middle, steps.end());
-  return *middle;
+  return upper_median(steps);
 }
 
 }  // namespace
@@ -290,9 +287,7 @@ std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& clou
   // beams (mixed pixels, noise).
   std::vector<size_t> sizes;
   for (const auto& [a, b] : runs) sizes.push_back(b - a);
-  auto middle = sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2);
-  std::nth_element(sizes.begin(), middle, sizes.end());
-  const size_t min_points = std::max<size_t>(8, *middle / 5);
+  const size_t min_points = std::max<size_t>(8, upper_median(sizes) / 5);
   std::vector<std::optional<double>> elevation_rad;
   std::vector<double> columns;
   size_t on_beams = 0;
@@ -309,10 +304,8 @@ std::optional<config::SensorModel> sensor_from_elevations(const PointCloud& clou
   if (beams < kMinMeasuredBeams || beams > kMaxMeasuredBeams || columns.empty() ||
       static_cast<double>(on_beams) < kMinFitFraction * static_cast<double>(points.size()))
     return std::nullopt;
-  auto column_middle = columns.begin() + static_cast<std::ptrdiff_t>(columns.size() / 2);
-  std::nth_element(columns.begin(), column_middle, columns.end());
   std::optional<config::SensorModel> model =
-      sensor_from_rows(elevation_rad, static_cast<int>(std::lround(*column_middle)));
+      sensor_from_rows(elevation_rad, static_cast<int>(std::lround(upper_median(columns))));
   if (model) model->name = "measured-" + std::to_string(beams) + "-beams";
   return model;
 }
