@@ -234,6 +234,10 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
   result = run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav.ply").string());
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("-o names a folder"), std::string::npos) << result.output;
+  // A folder whose name holds a dot is a folder all the same.
+  result = run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav_2.5").string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "nav_2.5" / "navmesh.json"));
 }
 
 TEST(CliMesh, ErrorsAreClear) {
