@@ -2,14 +2,14 @@
 # Time and peak memory of each command against the route's length: prefixes of the city's
 # 5 km tour (featsense simulate --scene city --path tour --frames N, 7 m/s at 10 Hz, so
 # N = km * 10000 / 7), each simulated, mapped with its mesh as a tile set and compared with
-# the truth (map --tiles), meshed again with cleanup (mesh --tiles --clean), evaluated
-# again by region (eval mesh on the tile set against gt_points.ply) and its report page
-# written again (report).
+# the truth (map --tiles), meshed again with cleanup (mesh --tiles --clean), its navigation
+# layers made tile by tile (navmesh on the cleaned tile set), evaluated again by region (eval
+# mesh on the tile set against gt_points.ply) and its report page written again (report).
 #
 #   city_scaling.sh WORK [KM ...]   (default: 1 2.5 5)
 #
 # Writes WORK/city_KM/ (the recording; its frames are removed after mapping unless KEEP=1:
-# 5.6 GB a kilometre), WORK/map_KM/, WORK/clean_KM/, WORK/eval_KM.json and one
+# 5.6 GB a kilometre), WORK/map_KM/, WORK/clean_KM/, WORK/nav_KM/, WORK/eval_KM.json and one
 # WORK/KM.COMMAND.time.txt (/usr/bin/time -v) per command, and prints one JSON line per route:
 # the frames, each command's wall seconds and peak RSS (GB), and the map's figures.
 # FEATSENSE names the program (default: build/app/featsense); BACKEND the TSDF backend (auto).
@@ -31,13 +31,14 @@ timed() {  # timed KM NAME COMMAND...
 for km in "${routes[@]}"; do
   frames=$(python3 -c "print(round($km * 10000 / 7))")
   sim="$work/city_$km"
-  rm -rf "$sim" "$work/map_$km" "$work/clean_$km"
+  rm -rf "$sim" "$work/map_$km" "$work/clean_$km" "$work/nav_$km"
   timed "$km" simulate "$featsense" simulate --quiet --scene city --path tour --seed 4 \
     --frames "$frames" -o "$sim"
   timed "$km" map "$featsense" map --quiet "$sim" -o "$work/map_$km" --tiles --backend "$backend"
   [ "${KEEP:-0}" = 1 ] || rm -f "$sim"/frame_*.pcd
   timed "$km" mesh_clean "$featsense" mesh --quiet "$work/map_$km/map.h5" \
     --tiles "$work/clean_$km" --clean
+  timed "$km" navmesh "$featsense" navmesh "$work/clean_$km" -o "$work/nav_$km"
   timed "$km" eval_mesh "$featsense" eval mesh "$work/map_$km/tiles" "$sim/gt_points.ply" \
     --json "$work/eval_$km.json"
   timed "$km" report "$featsense" report "$work/map_$km"
@@ -58,7 +59,8 @@ report = json.load(open(f"{work}/map_{km}/report.json"))
 ev = report.get("eval", {})
 out = {"route_km": float(km), "frames": frames,
        "commands": {name: figures(name)
-                    for name in ("simulate", "map", "mesh_clean", "eval_mesh", "report")},
+                    for name in ("simulate", "map", "mesh_clean", "navmesh", "eval_mesh",
+                                 "report")},
        "chunks": report["map"]["chunks"],
        "triangles": report["mesh"]["triangles"],
        "tiles": report["mesh"]["tiles"]["tiles"],
