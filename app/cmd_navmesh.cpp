@@ -25,9 +25,7 @@ void run_navmesh(const NavmeshOptions& options, bool quiet) {
   if (viewer_export::is_tile_set(options.input)) {
     // A tile at a time (with its neighbours): the memory of a few tiles, whatever the map.
     // A folder's name may hold a dot (nav_2.5): only a mesh format's extension names a file.
-    const std::string extension = viewer_export::mesh_extension(options.output);
-    if (extension == ".ply" || extension == ".glb" || extension == ".gltf" || extension == ".obj" ||
-        extension == ".h5") {
+    if (viewer_export::is_writable_mesh_path(options.output)) {
       throw std::runtime_error(options.input +
                                " is a tile set: -o names a folder for its "
                                "tiles' layers, not a file (" +

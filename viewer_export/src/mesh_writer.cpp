@@ -47,11 +47,16 @@ std::string mesh_extension(const std::string& path) {
   return extension;
 }
 
+bool is_writable_mesh_path(const std::string& path) {
+  const std::string extension = mesh_extension(path);
+  return extension == ".ply" || extension == ".obj" || extension == ".glb" ||
+         extension == ".gltf" || extension == ".h5";
+}
+
 void write_mesh(const std::string& path, const mesh::TriangleMesh& mesh,
                 const MeshAttributes& attributes, const MeshWriteSettings& settings) {
   const std::string extension = mesh_extension(path);
-  if (extension != ".ply" && extension != ".obj" && extension != ".glb" && extension != ".gltf" &&
-      extension != ".h5") {
+  if (!is_writable_mesh_path(path)) {
     throw MeshFileError(path + ": unknown mesh format '" + extension + "' (write " + kWritable +
                         ")");
   }

@@ -28,4 +28,7 @@ mesh::TriangleMesh read_mesh(const std::string& path, MeshAttributes* attributes
 /// The lower-case extension with its dot (".ply"), or "" where there is none.
 std::string mesh_extension(const std::string& path);
 
+/// Whether `path`'s extension is one write_mesh writes.
+bool is_writable_mesh_path(const std::string& path);
+
 }  // namespace featsense::viewer_export
