@@ -107,10 +107,13 @@ struct Localizer::State {
     int64_t stamp_ns = 0;
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   };
+  /// The first of judge's tests a fit fails, in the order judge applies them.
+  enum class Shortfall { kNone, kObserved, kCoverage, kHeld, kInliers, kFitness };
   struct Fit {
     slam::refine::VgicpResult result;
     MapFit map;
     bool good = false;
+    Shortfall shortfall = Shortfall::kObserved;  ///< not judged: nothing observed
     bool contradicts = false;
     size_t points = 0;
   };
@@ -281,30 +284,43 @@ struct Localizer::State {
     // that ran out were trading voxels by millimetres.
     const bool held = fit.map.position_sigma_m <= settings.max_position_sigma_m &&
                       fit.map.rotation_sigma_deg <= settings.max_rotation_sigma_deg;
-    fit.good = enough && held && fit.map.inlier_fraction >= settings.min_inlier_fraction &&
-               fit.map.fitness_m <= settings.max_fitness_m;
+    const bool inliers = fit.map.inlier_fraction >= settings.min_inlier_fraction;
+    const bool close = fit.map.fitness_m <= settings.max_fitness_m;
+    fit.good = enough && held && inliers && close;
+    fit.shortfall = !telling   ? Shortfall::kObserved
+                    : !enough  ? Shortfall::kCoverage
+                    : !held    ? Shortfall::kHeld
+                    : !inliers ? Shortfall::kInliers
+                    : !close   ? Shortfall::kFitness
+                               : Shortfall::kNone;
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
   }
 
-  /// What keeps `fit` from being good, the first of judge's tests it fails.
-  std::string shortfall(const Fit& fit) const {
+  /// What keeps `fit` from being good (judge's first failed test), in words.
+  static std::string shortfall_text(const Fit& fit) {
     char text[96];
     const MapFit& m = fit.map;
-    if (m.observed < settings.min_observed_points) {
-      std::snprintf(text, sizeof text, "%zu of its points where the map observed anything",
-                    m.observed);
-    } else if (m.coverage < settings.min_coverage) {
-      std::snprintf(text, sizeof text, "%d %% of the scan where the map observed anything",
-                    static_cast<int>(100.0 * m.coverage));
-    } else if (m.position_sigma_m > settings.max_position_sigma_m ||
-               m.rotation_sigma_deg > settings.max_rotation_sigma_deg) {
-      std::snprintf(text, sizeof text, "held to %.0f mm, %.2f deg only",
-                    1000.0 * m.position_sigma_m, m.rotation_sigma_deg);
-    } else if (m.inlier_fraction < settings.min_inlier_fraction) {
-      std::snprintf(text, sizeof text, "%d %% of the scan on it",
-                    static_cast<int>(100.0 * m.inlier_fraction));
-    } else {
-      std::snprintf(text, sizeof text, "fitness %.1f mm", 1000.0 * m.fitness_m);
+    switch (fit.shortfall) {
+      case Shortfall::kObserved:
+        std::snprintf(text, sizeof text, "%zu of its points where the map observed anything",
+                      m.observed);
+        break;
+      case Shortfall::kCoverage:
+        std::snprintf(text, sizeof text, "%d %% of the scan where the map observed anything",
+                      static_cast<int>(100.0 * m.coverage));
+        break;
+      case Shortfall::kHeld:
+        std::snprintf(text, sizeof text, "held to %.0f mm, %.2f deg only",
+                      1000.0 * m.position_sigma_m, m.rotation_sigma_deg);
+        break;
+      case Shortfall::kInliers:
+        std::snprintf(text, sizeof text, "%d %% of the scan on it",
+                      static_cast<int>(100.0 * m.inlier_fraction));
+        break;
+      case Shortfall::kFitness:
+      case Shortfall::kNone:
+        std::snprintf(text, sizeof text, "fitness %.1f mm", 1000.0 * m.fitness_m);
+        break;
     }
     return text;
   }
@@ -350,7 +366,7 @@ struct Localizer::State {
       std::snprintf(text, sizeof text,
                     "a match with the map's keyframes at (%.1f, %.1f, %.1f) that its surface "
                     "does not confirm (%s): searching on",
-                    at.x(), at.y(), at.z(), shortfall(fit).c_str());
+                    at.x(), at.y(), at.z(), shortfall_text(fit).c_str());
       out.event = text;
       // The relocalizer keeps a placement once made; a fresh one searches on, with the same
       // odometry.
