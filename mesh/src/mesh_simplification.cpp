@@ -110,8 +110,17 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifySettings& s
 
 TriangleMesh weld_by_position(const std::vector<const TriangleMesh*>& parts) {
   TriangleMesh out;
-  bool normals = !parts.empty();
-  for (const TriangleMesh* part : parts) normals = normals && part->has_normals();
+  // A part without vertices (a neighbour's triangles near a tile, none there) has no normals
+  // to miss.
+  bool normals = false;
+  for (const TriangleMesh* part : parts) {
+    if (part->vertices.empty()) continue;
+    if (!part->has_normals()) {
+      normals = false;
+      break;
+    }
+    normals = true;
+  }
   std::unordered_map<PositionKey, int32_t, PositionKeyHash> seen;
   std::vector<int32_t> remap;
   for (const TriangleMesh* part : parts) {

@@ -169,4 +169,12 @@ Eigen::AlignedBox3d triangle_bounds(const TriangleMesh& mesh, std::size_t t) {
   return box;
 }
 
+TriangleMesh triangles_meeting(const TriangleMesh& mesh, const Eigen::AlignedBox3d& box) {
+  std::vector<uint32_t> meeting;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (triangle_bounds(mesh, t).intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
+  }
+  return triangle_subset(mesh, meeting);
+}
+
 }  // namespace featsense::mesh

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "featsense/mesh/mesh_simplification.hpp"
 #include "featsense/mesh/triangle_mesh.hpp"
 
 namespace featsense::test {
@@ -152,6 +153,48 @@ TEST(TriangleMesh, ASubsetKeepsItsTrianglesAndOnlyTheirVertices) {
   ASSERT_EQ(sub.triangles.size(), 1u);
   EXPECT_EQ(sub.triangles[0], Eigen::Vector3i(0, 1, 2));
   EXPECT_TRUE(mesh::triangle_subset(m, {}).vertices.empty());
+}
+
+TEST(TriangleMesh, TrianglesMeetingABoxKeepEveryFaceOfTheVerticesInIt) {
+  // A fan of 8 triangles around the origin and a far triangle: a box around the centre alone
+  // keeps the whole fan (each face holds the centre), a box off to one side only what it meets.
+  mesh::TriangleMesh m;
+  m.vertices.push_back(Eigen::Vector3f::Zero());
+  for (int k = 0; k < 8; ++k) {
+    const float a = static_cast<float>(k) * 3.14159265f / 4.0f;
+    m.vertices.emplace_back(std::cos(a), std::sin(a), 0.0f);
+  }
+  for (int k = 0; k < 8; ++k) m.triangles.emplace_back(0, 1 + k, 1 + (k + 1) % 8);
+  m.vertices.emplace_back(10.0f, 10.0f, 0.0f);
+  m.vertices.emplace_back(11.0f, 10.0f, 0.0f);
+  m.vertices.emplace_back(10.0f, 11.0f, 0.0f);
+  m.triangles.emplace_back(9, 10, 11);
+  const Eigen::AlignedBox3d centre(Eigen::Vector3d(-0.01, -0.01, -0.01),
+                                   Eigen::Vector3d(0.01, 0.01, 0.01));
+  EXPECT_EQ(mesh::triangles_meeting(m, centre).triangles.size(), 8u);
+  const Eigen::AlignedBox3d right(Eigen::Vector3d(0.9, -0.1, -0.1), Eigen::Vector3d(2, 0.1, 0.1));
+  EXPECT_EQ(mesh::triangles_meeting(m, right).triangles.size(), 2u);  // both faces of (1,0,0)
+  const Eigen::AlignedBox3d nowhere(Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(6, 6, 6));
+  EXPECT_TRUE(mesh::triangles_meeting(m, nowhere).vertices.empty());
+}
+
+TEST(TriangleMesh, WeldingKeepsNormalsPastAnEmptyPart) {
+  // A part with nothing in it (no triangles of a neighbour near a tile) does not cost the
+  // others their normals; a part with vertices and no normals does.
+  mesh::TriangleMesh a;
+  a.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  a.normals.assign(3, Eigen::Vector3f::UnitX());
+  a.triangles = {{0, 1, 2}};
+  mesh::TriangleMesh b = a;
+  b.vertices[2] = {1, 1, 0};
+  const mesh::TriangleMesh empty;
+  const mesh::TriangleMesh welded = mesh::weld_by_position({&a, &empty, &b});
+  EXPECT_EQ(welded.vertices.size(), 4u);
+  ASSERT_TRUE(welded.has_normals());
+  EXPECT_EQ(welded.normals[3], Eigen::Vector3f::UnitX());
+  b.normals.clear();
+  EXPECT_FALSE(mesh::weld_by_position({&a, &empty, &b}).has_normals());
+  EXPECT_TRUE(mesh::weld_by_position({&empty}).vertices.empty());
 }
 
 }  // namespace

@@ -87,16 +87,6 @@ mesh::TriangleMesh weld_within(const mesh::TriangleMesh& mesh, double tolerance_
   return out;
 }
 
-/// The triangles of `mesh` whose bounding box meets `box`, with the vertices they use.
-mesh::TriangleMesh triangles_meeting(const mesh::TriangleMesh& mesh,
-                                     const Eigen::AlignedBox3d& box) {
-  std::vector<uint32_t> meeting;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (mesh::triangle_bounds(mesh, t).intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
-  }
-  return mesh::triangle_subset(mesh, meeting);
-}
-
 class TileSetRegions final : public mesh::SurfaceRegions {
  public:
   TileSetRegions(const fs::path& dir, std::size_t cached_tiles) : reader_(dir, cached_tiles) {
@@ -116,7 +106,7 @@ class TileSetRegions final : public mesh::SurfaceRegions {
     std::vector<mesh::TriangleMesh> clipped;
     for (std::size_t i = 0; i < reader_.tiles().size(); ++i) {
       if (!reader_.tiles()[i].bounds.intersects(box)) continue;
-      clipped.push_back(triangles_meeting(*reader_.tile(i), box));
+      clipped.push_back(mesh::triangles_meeting(*reader_.tile(i), box));
     }
     std::vector<const mesh::TriangleMesh*> parts;
     for (const mesh::TriangleMesh& part : clipped) parts.push_back(&part);
@@ -171,19 +161,26 @@ TileSetReader::TileSetReader(fs::path dir, std::size_t cached_tiles)
       cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {}
 
 std::shared_ptr<const mesh::TriangleMesh> TileSetReader::tile(std::size_t i) const {
-  const auto found = cache_.find(i);
-  if (found != cache_.end()) {
-    recent_.remove(i);
-    recent_.push_front(i);
-    return found->second;
+  {
+    const std::lock_guard<std::mutex> lock(cache_mutex_);
+    const auto found = cache_.find(i);
+    if (found != cache_.end()) {
+      recent_.remove(i);
+      recent_.push_front(i);
+      return found->second;
+    }
   }
+  // Read without the lock, so that other threads' tiles are read meanwhile; two threads that
+  // both miss the same tile read it twice, and the cache keeps one of the equal copies.
   auto loaded =
       std::make_shared<const mesh::TriangleMesh>(read_mesh((dir_ / tiles_.at(i).file).string()));
-  cache_[i] = loaded;
-  recent_.push_front(i);
-  while (recent_.size() > cached_tiles_) {
-    cache_.erase(recent_.back());
-    recent_.pop_back();
+  const std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (cache_.emplace(i, loaded).second) {
+    recent_.push_front(i);
+    while (recent_.size() > cached_tiles_) {
+      cache_.erase(recent_.back());
+      recent_.pop_back();
+    }
   }
   return loaded;
 }

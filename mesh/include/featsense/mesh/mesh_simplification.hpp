@@ -33,7 +33,7 @@ SimplifiedMesh simplify_mesh(const TriangleMesh& mesh, const SimplifySettings& s
                              const std::vector<bool>& held = {});
 
 /// The meshes as one, with the vertices that lie at exactly the same position (the shared
-/// border of two tiles) merged. Normals are kept where every part has them.
+/// border of two tiles) merged. Normals are kept where every part with vertices has them.
 TriangleMesh weld_by_position(const std::vector<const TriangleMesh*>& parts);
 
 }  // namespace featsense::mesh
