@@ -23,9 +23,10 @@ std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& m
 /// The layers of a tile set's full-resolution tiles (tile_set.hpp), one file per tile in
 /// `out_dir` (X_Y.EXT, EXT from `extension`: ".ply", ".glb", ...) and `navmesh.json` (the
 /// tiles, their triangles and lethal ones, the settings). Each tile is computed with the
-/// tiles around it (those within 1 m plus the radius), welded by position, so that its
+/// triangles of the tiles around it within the radius, welded by position, so that its
 /// border vertices have the neighbourhoods and normals they have in the whole mesh; memory is
-/// that of the reader's cache of tiles (16). Returns navmesh.json's content.
+/// that of the reader's cache of tiles (32) and a few tiles per core. Returns navmesh.json's
+/// content.
 nlohmann::json write_navigation_tiles(const std::filesystem::path& tile_set_dir,
                                       const std::filesystem::path& out_dir,
                                       const std::string& extension,

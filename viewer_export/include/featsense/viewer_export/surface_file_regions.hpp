@@ -8,6 +8,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,8 @@ struct TileSetEntry {
 std::vector<TileSetEntry> read_tile_set_index(const std::filesystem::path& dir);
 
 /// A tile set's full-resolution tiles read from disk as they are asked for, the last
-/// `cached_tiles` kept in memory. Throws MeshFileError naming the file that cannot be read.
+/// `cached_tiles` kept in memory; safe to ask from several threads at once. Throws
+/// MeshFileError naming the file that cannot be read.
 class TileSetReader {
  public:
   explicit TileSetReader(std::filesystem::path dir, std::size_t cached_tiles = 16);
@@ -43,6 +45,7 @@ class TileSetReader {
   // The cache is not the tile set's state: reading stays const.
   mutable std::map<std::size_t, std::shared_ptr<const mesh::TriangleMesh>> cache_;
   mutable std::list<std::size_t> recent_;  ///< most recent first
+  mutable std::mutex cache_mutex_;
 };
 
 /// A tile set's full-resolution tiles (tiles.json; PLY where written, else GLB), the last
