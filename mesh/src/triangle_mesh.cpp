@@ -170,11 +170,31 @@ Eigen::AlignedBox3d triangle_bounds(const TriangleMesh& mesh, std::size_t t) {
 }
 
 TriangleMesh triangles_meeting(const TriangleMesh& mesh, const Eigen::AlignedBox3d& box) {
-  std::vector<uint32_t> meeting;
+  // The vertices stay in the mesh's order: where copies of a position differ (a split
+  // non-manifold vertex's normals), welding keeps the first copy, the one the whole mesh
+  // would keep.
+  std::vector<int> index(mesh.vertices.size(), -1);
+  std::vector<std::size_t> meeting;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (triangle_bounds(mesh, t).intersects(box)) meeting.push_back(static_cast<uint32_t>(t));
+    if (!triangle_bounds(mesh, t).intersects(box)) continue;
+    meeting.push_back(t);
+    for (int k = 0; k < 3; ++k) index[static_cast<std::size_t>(mesh.triangles[t][k])] = 0;
   }
-  return triangle_subset(mesh, meeting);
+  TriangleMesh out;
+  const bool normals = mesh.has_normals();
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (index[v] < 0) continue;
+    index[v] = static_cast<int>(out.vertices.size());
+    out.vertices.push_back(mesh.vertices[v]);
+    if (normals) out.normals.push_back(mesh.normals[v]);
+  }
+  for (const std::size_t t : meeting) {
+    const Eigen::Vector3i& corners = mesh.triangles[t];
+    out.triangles.emplace_back(index[static_cast<std::size_t>(corners[0])],
+                               index[static_cast<std::size_t>(corners[1])],
+                               index[static_cast<std::size_t>(corners[2])]);
+  }
+  return out;
 }
 
 }  // namespace featsense::mesh

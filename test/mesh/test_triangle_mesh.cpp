@@ -173,7 +173,13 @@ TEST(TriangleMesh, TrianglesMeetingABoxKeepEveryFaceOfTheVerticesInIt) {
                                    Eigen::Vector3d(0.01, 0.01, 0.01));
   EXPECT_EQ(mesh::triangles_meeting(m, centre).triangles.size(), 8u);
   const Eigen::AlignedBox3d right(Eigen::Vector3d(0.9, -0.1, -0.1), Eigen::Vector3d(2, 0.1, 0.1));
-  EXPECT_EQ(mesh::triangles_meeting(m, right).triangles.size(), 2u);  // both faces of (1,0,0)
+  const mesh::TriangleMesh kept = mesh::triangles_meeting(m, right);
+  ASSERT_EQ(kept.triangles.size(), 2u);  // both faces of (1, 0, 0)
+  // The vertices in the mesh's order (0, 1, 2, 8), whatever the order of the faces (7, 0).
+  ASSERT_EQ(kept.vertices.size(), 4u);
+  EXPECT_EQ(kept.vertices[3], m.vertices[8]);
+  EXPECT_EQ(kept.triangles[0], Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(kept.triangles[1], Eigen::Vector3i(0, 3, 1));
   const Eigen::AlignedBox3d nowhere(Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(6, 6, 6));
   EXPECT_TRUE(mesh::triangles_meeting(m, nowhere).vertices.empty());
 }

@@ -95,8 +95,9 @@ TriangleMesh triangle_subset(const TriangleMesh& mesh, const std::vector<uint32_
 /// The axis-aligned box of triangle `t`'s three vertices, in doubles.
 Eigen::AlignedBox3d triangle_bounds(const TriangleMesh& mesh, std::size_t t);
 
-/// The triangles of `mesh` whose bounding box meets `box` (triangle_subset, in their order).
-/// Every vertex inside `box` keeps all of its faces.
+/// The triangles of `mesh` whose bounding box meets `box`, in their order, with the vertices
+/// they use in the mesh's order (normals kept, parts dropped). Every vertex inside `box` keeps
+/// all of its faces.
 TriangleMesh triangles_meeting(const TriangleMesh& mesh, const Eigen::AlignedBox3d& box);
 
 }  // namespace featsense::mesh
