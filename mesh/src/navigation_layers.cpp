@@ -1,5 +1,7 @@
 #include "featsense/mesh/navigation_layers.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -94,12 +96,13 @@ NavigationLayers compute_navigation_layers(const TriangleMesh& mesh,
   layers.cost.resize(n);
 
   const VertexGrid grid(mesh.vertices, settings.radius_m);
-  for (size_t i = 0; i < n; ++i) {
+  // Each vertex's layers depend on the mesh alone: the same values on any number of threads.
+  const auto vertex_layers = [&](size_t i, std::vector<size_t>& neighbours) {
     layers.inclination_deg[i] = static_cast<float>(angle_deg(normals[i], Eigen::Vector3f::UnitZ()));
     float z_min = mesh.vertices[i].z();
     float z_max = z_min;
     Eigen::Vector3f normal_sum = Eigen::Vector3f::Zero();
-    std::vector<size_t> neighbours;
+    neighbours.clear();
     grid.for_each_within(mesh.vertices[i], settings.radius_m, [&](size_t j) {
       z_min = std::min(z_min, mesh.vertices[j].z());
       z_max = std::max(z_max, mesh.vertices[j].z());
@@ -122,7 +125,13 @@ NavigationLayers compute_navigation_layers(const TriangleMesh& mesh,
     const double step_ratio = layers.height_diff_m[i] / settings.max_step_m;
     const double ratio = std::max(slope_ratio, step_ratio);
     layers.cost[i] = ratio >= 1.0 ? 1.0f : static_cast<float>(ratio);
-  }
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      std::vector<size_t> neighbours;
+                      for (size_t i = range.begin(); i != range.end(); ++i)
+                        vertex_layers(i, neighbours);
+                    });
 
   layers.lethal_faces.resize(mesh.triangles.size());
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
