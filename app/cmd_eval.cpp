@@ -139,9 +139,11 @@ void run_mesh(const EvalMeshOptions& options) {
   mesh::CompareSettings settings;
   settings.max_dist_m = options.max_dist_m;
   settings.samples_per_m2 = options.samples_per_m2;
+  mesh::RegionComparisonSettings regions;
+  regions.keep_distances = options.ply_path.has_value();  // else the figures alone
   mesh::CompareResult result;
   try {
-    result = mesh::compare_by_region(*estimate, *reference, settings);
+    result = mesh::compare_by_region(*estimate, *reference, settings, regions);
   } catch (const mesh::MeshError& e) {
     throw std::runtime_error(options.estimate + " vs " + options.reference + ": " + e.what());
   }

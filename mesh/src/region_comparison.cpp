@@ -11,6 +11,7 @@
 
 #include "internal/closest_point_query.hpp"
 #include "internal/comparison_figures.hpp"
+#include "internal/distance_accumulator.hpp"
 #include "internal/surface_sampling.hpp"
 
 namespace featsense::mesh {
@@ -116,7 +117,8 @@ class RegionComparison {
         reference_(reference),
         settings_(settings),
         regions_(regions),
-        size_(regions.region_size_m) {}
+        size_(regions.region_size_m),
+        distances_(settings) {}
 
   CompareResult run() {
     if (!(size_ > 0.0) || !(regions_.margin_m >= 0.0)) {
@@ -131,7 +133,8 @@ class RegionComparison {
     total_ = (regions_.accuracy ? estimate_cells.size() : 0) +
              (regions_.completeness ? reference_cells.size() : 0);
     if (regions_.accuracy) {
-      if (const std::optional<uint64_t> n = estimate_.vertex_count()) {
+      const std::optional<uint64_t> n = estimate_.vertex_count();
+      if (regions_.keep_distances && n) {
         ordered_ = true;
         result_.unsigned_distance_m.assign(*n, 0.0f);
         result_.signed_distance_m.assign(*n, 0.0f);
@@ -145,10 +148,10 @@ class RegionComparison {
         throw MeshError("the reference mesh is degenerate: all its triangles have zero area");
       }
     }
-    internal::fill_accuracy_figures(settings_, &result_);
+    distances_.fill(&result_);
     within_.assign(settings_.thresholds_m.size(), 0);
     if (regions_.completeness) completeness(reference_cells);
-    internal::fill_scores(settings_, within_, &result_);
+    internal::fill_scores(settings_, distances_.within(), within_, &result_);
     return std::move(result_);
   }
 
@@ -161,9 +164,11 @@ class RegionComparison {
   void record(size_t slot, const Distance& d) {
     const double sign = d.side > 0.0 ? 1.0 : (d.side < 0.0 ? -1.0 : 0.0);
     const auto value = static_cast<float>(d.distance_m);
+    const float signed_value = result_.signed_distances ? static_cast<float>(sign) * value : value;
+    distances_.add(value, signed_value);
+    if (!regions_.keep_distances) return;
     result_.unsigned_distance_m[slot] = value;
-    result_.signed_distance_m[slot] =
-        result_.signed_distances ? static_cast<float>(sign) * value : value;
+    result_.signed_distance_m[slot] = signed_value;
   }
 
   void note_reference(const internal::ClosestPointQuery& query) {
@@ -195,10 +200,10 @@ class RegionComparison {
       });
     }
     for (size_t k = 0; k < owned.size(); ++k) {
-      size_t slot = 0;
+      size_t slot = 0;  // unused where the distances are not kept
       if (ordered_) {
         slot = static_cast<size_t>(piece.source_index[owned[k]]);
-      } else {
+      } else if (regions_.keep_distances) {
         slot = result_.unsigned_distance_m.size();
         result_.unsigned_distance_m.push_back(0.0f);
         result_.signed_distance_m.push_back(0.0f);
@@ -316,6 +321,7 @@ class RegionComparison {
   const RegionComparisonSettings& regions_;
   double size_;
   CompareResult result_;
+  internal::DistanceAccumulator distances_;
   bool ordered_ = false;
   bool reference_usable_ = false;
   std::vector<Pending> pending_;

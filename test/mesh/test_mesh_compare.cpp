@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "featsense/mesh/compare_to_reference.hpp"
 #include "mesh_test_shapes.hpp"
@@ -59,6 +63,48 @@ TEST(MeshCompare, PointsAboveAndBelowAPlane) {
   EXPECT_NEAR(r.scores[0].precision, 0.2, 1e-12);
   EXPECT_NEAR(r.scores[1].precision, 0.6, 1e-12);
   EXPECT_NEAR(r.scores[2].precision, 0.6, 1e-12);
+}
+
+TEST(MeshCompare, StatisticsOfManyDistancesAreThoseOfTheSortedDistances) {
+  // 200,000 distances spread over six decades (and exact zeros and one far outlier): the
+  // figures gathered a distance at a time against those of the sorted list.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> log_metres(std::log(0.05), 1.5);
+  std::bernoulli_distribution below(0.4);
+  std::vector<float> signed_m;
+  for (int i = 0; i < 200000; ++i) {
+    const double d = i % 1000 == 0 ? 0.0 : std::min(std::exp(log_metres(rng)), 50.0);
+    signed_m.push_back(static_cast<float>(below(rng) ? -d : d));
+  }
+  signed_m.push_back(1.0e6f);
+  const mesh::DistanceStatistics s = mesh::distance_statistics(signed_m);
+  std::vector<double> magnitudes;
+  double sum = 0.0, sum_abs = 0.0, sum_squares = 0.0;
+  for (const float d : signed_m) {
+    magnitudes.push_back(std::abs(static_cast<double>(d)));
+    sum += d;
+    sum_abs += std::abs(static_cast<double>(d));
+    sum_squares += static_cast<double>(d) * d;
+  }
+  std::sort(magnitudes.begin(), magnitudes.end());
+  const double n = static_cast<double>(signed_m.size());
+  ASSERT_EQ(s.count, signed_m.size());
+  EXPECT_NEAR(s.mean_signed, sum / n, 1e-9);
+  EXPECT_NEAR(s.mean_abs, sum_abs / n, 1e-9);
+  EXPECT_NEAR(s.rmse, std::sqrt(sum_squares / n), 1e-9);
+  double deviations = 0.0;
+  for (const float d : signed_m) deviations += (d - sum / n) * (d - sum / n);
+  EXPECT_NEAR(s.std_signed, std::sqrt(deviations / n), 1e-6 * s.std_signed);
+  const size_t half = signed_m.size() / 2;  // an odd count: the middle one
+  EXPECT_NEAR(s.median, magnitudes[half], 3e-5 * magnitudes[half]);
+  const size_t rank = static_cast<size_t>(std::ceil(0.95 * n)) - 1;
+  EXPECT_NEAR(s.p95, magnitudes[rank], 3e-5 * magnitudes[rank]);
+  EXPECT_EQ(s.max, 1.0e6);
+  // Where each bin holds one value, the figures are exact.
+  const mesh::DistanceStatistics few = mesh::distance_statistics({0.25f, -0.05f, 0.15f, 0.0f});
+  EXPECT_EQ(few.median, 0.5 * (static_cast<double>(0.05f) + static_cast<double>(0.15f)));
+  EXPECT_EQ(few.p95, static_cast<double>(0.25f));
+  EXPECT_EQ(mesh::distance_statistics({}).count, 0u);
 }
 
 TEST(MeshCompare, PointsOffABoxInsideOutsideAndBeyondACorner) {

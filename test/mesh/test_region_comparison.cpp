@@ -110,6 +110,24 @@ TEST(RegionComparison, AgainstAMeshEqualsTheWholeComparison) {
   EXPECT_GT(whole_limited.beyond_max_dist, 100u);
   EXPECT_EQ(regions_limited.beyond_max_dist, whole_limited.beyond_max_dist);
   expect_same_accuracy(whole_limited, regions_limited);
+
+  // The figures alone, without the per-vertex distances: the same figures.
+  mesh::RegionComparisonSettings figures_only = small_regions();
+  figures_only.keep_distances = false;
+  const mesh::CompareResult lean = mesh::compare_by_region(
+      mesh::MeshRegions(estimate, 4.0), mesh::MeshRegions(truth, 3.0), settings(), figures_only);
+  EXPECT_TRUE(lean.unsigned_distance_m.empty());
+  EXPECT_TRUE(lean.signed_distance_m.empty());
+  EXPECT_EQ(lean.points, whole.points);
+  EXPECT_NEAR(lean.accuracy.mean_abs, whole.accuracy.mean_abs, 1e-9);
+  EXPECT_NEAR(lean.accuracy.std_signed, whole.accuracy.std_signed, 1e-9);
+  EXPECT_DOUBLE_EQ(lean.accuracy.median, by_region.accuracy.median);
+  EXPECT_DOUBLE_EQ(lean.accuracy.p95, by_region.accuracy.p95);
+  EXPECT_EQ(lean.accuracy.max, whole.accuracy.max);
+  EXPECT_EQ(lean.histogram_counts, whole.histogram_counts);
+  for (size_t k = 0; k < whole.scores.size(); ++k) {
+    EXPECT_DOUBLE_EQ(lean.scores[k].precision, whole.scores[k].precision);
+  }
 }
 
 TEST(RegionComparison, AgainstATiledCloudEqualsTheWholeComparison) {

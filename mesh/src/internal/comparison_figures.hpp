@@ -1,6 +1,6 @@
 #pragma once
-// The figures of a comparison from its distances, shared by the whole and the by-region
-// comparison so that both report the same way.
+// The scores of a comparison from its counts, shared by the whole and the by-region
+// comparison so that both report the same way (the accuracy: distance_accumulator.hpp).
 
 #include <cstddef>
 #include <vector>
@@ -9,13 +9,9 @@
 
 namespace featsense::mesh::internal {
 
-/// From result->unsigned_distance_m and signed_distance_m: points, beyond_max_dist, accuracy
-/// and the histogram.
-void fill_accuracy_figures(const CompareSettings& settings, CompareResult* result);
-
-/// Precision from the distances, completeness from `samples_within` (per threshold, of
-/// result->reference_samples), and the F-scores.
-void fill_scores(const CompareSettings& settings, const std::vector<size_t>& samples_within,
-                 CompareResult* result);
+/// Precision from `points_within` (per threshold, of result->points), completeness from
+/// `samples_within` (per threshold, of result->reference_samples), and the F-scores.
+void fill_scores(const CompareSettings& settings, const std::vector<size_t>& points_within,
+                 const std::vector<size_t>& samples_within, CompareResult* result);
 
 }  // namespace featsense::mesh::internal

@@ -17,8 +17,10 @@
 ///   belonging to the region of their centroid, a seed per region) at the density that
 ///   compare_to_reference uses (max_samples over the total area): the same expected
 ///   figure, other random samples.
-/// Per-vertex distances (CompareResult::unsigned_distance_m) are in the estimate's vertex
-/// order where it has one (SurfaceRegions::vertex_count), else in the order of the regions.
+/// Per-vertex distances (CompareResult::unsigned_distance_m, where kept) are in the
+/// estimate's vertex order where it has one (SurfaceRegions::vertex_count), else in the order
+/// of the regions. The median and p95 are within 0.003 % of the exact order statistics (a
+/// histogram of |d|, internal/distance_accumulator.hpp), in the whole comparison too.
 
 #include <functional>
 
@@ -32,6 +34,10 @@ struct RegionComparisonSettings {
   double margin_m = 2.0;
   bool accuracy = true;      ///< estimate -> reference (distances, accuracy, precision)
   bool completeness = true;  ///< reference -> estimate
+  /// Per-vertex distances in the result (CompareResult::unsigned_distance_m, for a mesh
+  /// coloured by them); without them the figures alone, in memory that does not grow with
+  /// the estimate.
+  bool keep_distances = true;
   /// Called after each region with (regions done, regions), for progress.
   std::function<void(size_t, size_t)> progress;
 };
