@@ -25,8 +25,8 @@ std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& m
 /// tiles, their triangles and lethal ones, the settings). Each tile is computed with the
 /// triangles of the tiles around it within the radius, welded by position, so that its
 /// border vertices have the neighbourhoods and normals they have in the whole mesh; memory is
-/// that of the reader's cache of tiles (32) and a few tiles per core. Returns navmesh.json's
-/// content.
+/// that of the reader's cache (8 tiles a thread, at most 4 threads) and of the tiles in work.
+/// Returns navmesh.json's content.
 nlohmann::json write_navigation_tiles(const std::filesystem::path& tile_set_dir,
                                       const std::filesystem::path& out_dir,
                                       const std::string& extension,
