@@ -38,6 +38,16 @@ Index3 brick_corner_in_chunk(Index3 brick, const ChunkKey& key) {
           brick.z * kBrickSize - key.z * kChunkSize};
 }
 
+/// x-fastest order of bricks (as tsdf::bricks_of lists them).
+bool brick_less(const Index3& a, const Index3& b) {
+  return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
+}
+
+/// The voxels of a batch of chunks (32 MB at most) or of the stored bricks that enter the
+/// local map: kept from one shift to the next up to this size, so that its pages are not
+/// faulted in and cleared each time.
+constexpr size_t kSlabKeptVoxels = kChunksPerBatch * kChunkVoxels;
+
 /// The bricks of one chunk: indices into the list of bricks.
 struct ChunkGroup {
   ChunkKey key;
@@ -185,29 +195,89 @@ bool ShiftingMap::follow(tsdf::Vec3 sensor_m) {
 bool ShiftingMap::move_to(Index3 origin) {
   const Index3 now = map_.geometry().origin;
   if (origin.x == now.x && origin.y == now.y && origin.z == now.z) return false;
-  const tsdf::ShiftStats shift = tsdf::shift_local_map(
-      map_, origin,
-      [this](const std::vector<Index3>& bricks, std::vector<uint32_t>& voxels) {
-        load(bricks, voxels);
-      },
-      [this](const std::vector<Index3>& bricks, const std::vector<uint32_t>& voxels) {
-        spill(bricks, [&](size_t k) { return voxels.data() + k * kBrickVoxels; });
-      },
-      shift_buffers_);
-  if (shift.bricks_left == 0) return true;
+  tsdf::LocalMapGeometry target = map_.geometry();
+  target.origin = origin;
+  const tsdf::BrickExchange exchange = tsdf::exchanged_bricks(map_.geometry(), target);
+  if (exchange.leaving.empty()) {
+    map_.set_origin(origin);
+    return true;
+  }
+  // The bricks that leave go into the store first, a few chunks at a time, while the map
+  // still holds them: a failing write leaves the map whole where it was. (A chunk that holds
+  // both leaving and entering bricks is read back below with the leaving ones merged in;
+  // the entering ones' part of it is the store's either way.)
+  spill_from_map(exchange.leaving);
+  // The entering bricks the store holds are read before the map moves, so that a failing
+  // read leaves it unmoved too. Outside the places mapped before that is none of them.
+  std::vector<Index3> stored;
+  std::vector<Index3> unobserved;
+  load_stored(exchange.entering, stored, slab_, unobserved);
+  map_.set_origin(origin);
+  map_.write_bricks(stored, slab_);
+  if (slab_.size() > kSlabKeptVoxels) std::vector<uint32_t>().swap(slab_);
+  clear_bricks(unobserved);
   ++stats_.shifts;
-  stats_.bricks_spilled += shift.bricks_left;
-  stats_.bricks_loaded += shift.bricks_entered;
+  stats_.bricks_spilled += exchange.leaving.size();
+  stats_.bricks_loaded += exchange.entering.size();
   return true;
 }
 
 void ShiftingMap::sync() {
-  const std::vector<uint32_t> all = map_.download();
-  const tsdf::LocalMapGeometry& geometry = map_.geometry();
-  const std::vector<Index3> bricks = tsdf::bricks_of(geometry);
-  spill(bricks, [&](size_t k) { return all.data() + geometry.brick_offset(bricks[k]); });
+  spill_from_map(tsdf::bricks_of(map_.geometry()));
   store_.flush();
   ++stats_.syncs;
+}
+
+void ShiftingMap::spill_from_map(const std::vector<Index3>& bricks) {
+  const std::vector<ChunkGroup> groups = group_by_chunk(bricks);
+  std::vector<Index3> batch;
+  for_each_batch(groups, [&](size_t first, size_t count) {
+    batch.clear();
+    for (size_t i = first; i < first + count; ++i)
+      for (const size_t k : groups[i].members) batch.push_back(bricks[k]);
+    map_.read_bricks(batch, slab_);
+    spill(batch, [&](size_t k) { return slab_.data() + k * kBrickVoxels; });
+  });
+}
+
+void ShiftingMap::load_stored(const std::vector<Index3>& bricks, std::vector<Index3>& stored,
+                              std::vector<uint32_t>& voxels, std::vector<Index3>& absent) {
+  stored.clear();
+  absent.clear();
+  voxels.clear();
+  const std::vector<ChunkGroup> groups = group_by_chunk(bricks);
+  for_each_batch(groups, [&](size_t first, size_t count) {
+    std::vector<std::optional<Chunk>> chunks(count);
+    std::vector<size_t> start(count);  // of each chunk's bricks in `stored`
+    for (size_t i = 0; i < count; ++i) {
+      chunks[i] = store_.read(groups[first + i].key);
+      start[i] = stored.size();
+      for (const size_t k : groups[first + i].members)
+        (chunks[i] ? stored : absent).push_back(bricks[k]);
+    }
+    voxels.resize(stored.size() * kBrickVoxels);
+    tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+      if (!chunks[i]) return;
+      const ChunkGroup& group = groups[first + i];
+      for (size_t m = 0; m < group.members.size(); ++m) {
+        const Index3 brick = bricks[group.members[m]];
+        copy_brick_from_chunk(*chunks[i], brick_corner_in_chunk(brick, group.key),
+                              voxels.data() + (start[i] + m) * kBrickVoxels);
+      }
+    });
+  });
+}
+
+void ShiftingMap::clear_bricks(const std::vector<Index3>& bricks) {
+  constexpr size_t kBricksPerWrite = 4096;  // 8 MB of unobserved voxels
+  std::vector<Index3> batch;
+  for (size_t first = 0; first < bricks.size(); first += kBricksPerWrite) {
+    const size_t count = std::min(kBricksPerWrite, bricks.size() - first);
+    batch.assign(bricks.begin() + static_cast<std::ptrdiff_t>(first),
+                 bricks.begin() + static_cast<std::ptrdiff_t>(first + count));
+    unobserved_.resize(count * kBrickVoxels, tsdf::kUnobservedVoxel);  // all unobserved
+    map_.write_bricks(batch, unobserved_);
+  }
 }
 
 void ShiftingMap::read_block(Index3 origin, Index3 dim, std::vector<uint32_t>& voxels) {
@@ -223,9 +293,6 @@ void ShiftingMap::read_blocks(const std::vector<Index3>& origins, Index3 dim,
   std::vector<Index3> bricks;
   for (const Index3& origin : origins)
     for_each_brick_in_box(origin, dim, [&](Index3 b) { bricks.push_back(b); });
-  const auto brick_less = [](const Index3& a, const Index3& b) {
-    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
-  };
   std::sort(bricks.begin(), bricks.end(), brick_less);
   bricks.erase(std::unique(bricks.begin(), bricks.end(),
                            [](const Index3& a, const Index3& b) {

@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -301,6 +303,116 @@ TEST(ShiftingMap, MovingFarAwayAndBackLosesNothing) {
   for (const uint32_t v : map->download()) ASSERT_EQ(v, tsdf::kUnobservedVoxel);
   shifting.move_to(home);
   EXPECT_EQ(map->download(), before);
+}
+
+/// A store that fails on request: its reads, its writes or both throw, as a full disk or a
+/// damaged file would make them.
+class FailingStore final : public ChunkStore {
+ public:
+  explicit FailingStore(ChunkStore& inner) : inner_(inner) {}
+  bool fail_reads = false;
+  bool fail_writes = false;
+  std::optional<Chunk> read(const ChunkKey& key) override {
+    if (fail_reads) throw std::runtime_error("read failed");
+    return inner_.read(key);
+  }
+  void write(const ChunkKey& key, const Chunk& chunk) override {
+    if (fail_writes) throw std::runtime_error("write failed");
+    inner_.write(key, chunk);
+  }
+  std::vector<ChunkKey> keys() const override { return inner_.keys(); }
+  void flush() override { inner_.flush(); }
+  const MapMetadata& metadata() const override { return inner_.metadata(); }
+
+ private:
+  ChunkStore& inner_;
+};
+
+TEST(ShiftingMap, AShiftThatCannotReachTheStoreLeavesTheMapWholeWhereItWas) {
+  MemoryChunkStore memory(metadata());
+  FailingStore store(memory);
+  auto map = tsdf::make_cpu_integrator(small_map_settings(), Vec3{0, 0, 1});
+  ShiftingMap shifting(*map, store, kShiftThreshold);
+  const double origin[3] = {0.2, 0.2, 1.0};
+  map->integrate(scan_from(origin));
+  // The wall at x = -1 goes into the store ...
+  shifting.move_to(
+      {map->geometry().origin.x + 24, map->geometry().origin.y, map->geometry().origin.z});
+  ASSERT_FALSE(memory.keys().empty());
+  map->integrate(scan_from(origin));
+  const std::vector<uint32_t> before = map->download();
+  const Index3 home = map->geometry().origin;
+  // ... and comes back, while the wall at y = -1 leaves.
+  const Index3 away = {home.x - 24, home.y + 24, home.z};
+  for (const bool reads : {true, false}) {
+    store.fail_reads = reads;
+    store.fail_writes = !reads;
+    EXPECT_THROW(shifting.move_to(away), std::runtime_error);
+    EXPECT_EQ(map->geometry().origin.x, home.x);
+    EXPECT_EQ(map->geometry().origin.y, home.y);
+    EXPECT_EQ(map->download(), before);
+  }
+  // Once the store works again the same shift and the way back lose nothing.
+  store.fail_reads = store.fail_writes = false;
+  EXPECT_TRUE(shifting.move_to(away));
+  EXPECT_TRUE(shifting.move_to(home));
+  EXPECT_EQ(map->download(), before);
+}
+
+/// An integrator that passes everything on and counts how much of the map is copied out at
+/// once.
+class CopyCountingMap final : public tsdf::Integrator {
+ public:
+  explicit CopyCountingMap(tsdf::Integrator& inner) : inner_(inner) {}
+  size_t most_bricks_read = 0;
+  size_t reads = 0;
+  size_t downloads = 0;
+  std::string backend_name() const override { return inner_.backend_name(); }
+  tsdf::IntegrationStats integrate(const tsdf::RayBatch& rays) override {
+    return inner_.integrate(rays);
+  }
+  const tsdf::LocalMapGeometry& geometry() const override { return inner_.geometry(); }
+  std::vector<uint32_t> download() const override {
+    ++const_cast<CopyCountingMap*>(this)->downloads;
+    return inner_.download();
+  }
+  size_t memory_bytes() const override { return inner_.memory_bytes(); }
+  void read_bricks(const std::vector<Index3>& bricks,
+                   std::vector<uint32_t>& voxels) const override {
+    auto* self = const_cast<CopyCountingMap*>(this);
+    self->most_bricks_read = std::max(most_bricks_read, bricks.size());
+    ++self->reads;
+    inner_.read_bricks(bricks, voxels);
+  }
+  void write_bricks(const std::vector<Index3>& bricks,
+                    const std::vector<uint32_t>& voxels) override {
+    inner_.write_bricks(bricks, voxels);
+  }
+  void set_origin(Index3 origin) override { inner_.set_origin(origin); }
+
+ private:
+  tsdf::Integrator& inner_;
+};
+
+TEST(ShiftingMap, ASyncCopiesTheMapOutABatchOfChunksAtATime) {
+  // About 30 x 30 x 12 m in voxels of 0.1 m: 75 chunks of 64^3 voxels or more, more than
+  // two batches of 32.
+  tsdf::TsdfSettings settings = large_map_settings();
+  settings.map_size_m = {30.0f, 30.0f, 12.0f};
+  MemoryChunkStore store(metadata());
+  auto inner = tsdf::make_cpu_integrator(settings, Vec3{3, 3, 1.5});
+  CopyCountingMap map(*inner);
+  ShiftingMap shifting(map, store, kShiftThreshold);
+  for (const Vec3& p : sensor_path()) {
+    const double at[3] = {p.x, p.y, p.z};
+    map.integrate(scan_from(at));
+  }
+  shifting.sync();
+  EXPECT_EQ(map.downloads, 0u);
+  EXPECT_GT(map.reads, 2u);
+  EXPECT_LE(map.most_bricks_read, size_t{32} * 512);  // 32 chunks of 8^3 bricks
+  EXPECT_LT(map.most_bricks_read, tsdf::bricks_of(map.geometry()).size());
+  expect_same_map(store, *inner);
 }
 
 TEST(ShiftingMap, ExchangedBricksAreTheSymmetricDifference) {

@@ -36,30 +36,6 @@ BrickExchange exchanged_bricks(const LocalMapGeometry& from, const LocalMapGeome
   return exchange;
 }
 
-ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
-                           const BrickSink& spill) {
-  ShiftBuffers buffers;
-  return shift_local_map(map, new_origin, load, spill, buffers);
-}
-
-ShiftStats shift_local_map(Integrator& map, Index3 new_origin, const BrickSource& load,
-                           const BrickSink& spill, ShiftBuffers& buffers) {
-  LocalMapGeometry target = map.geometry();
-  target.origin = new_origin;
-  const BrickExchange exchange = exchanged_bricks(map.geometry(), target);
-  ShiftStats stats;
-  stats.bricks_left = exchange.leaving.size();
-  stats.bricks_entered = exchange.entering.size();
-  if (exchange.leaving.empty()) return stats;
-
-  map.read_bricks(exchange.leaving, buffers.leaving);
-  load(exchange.entering, buffers.entering);
-  map.set_origin(new_origin);
-  map.write_bricks(exchange.entering, buffers.entering);
-  spill(exchange.leaving, buffers.leaving);
-  return stats;
-}
-
 Index3 centred_origin(const LocalMapGeometry& geometry, Vec3 centre_m) {
   const Index3 centre = geometry.voxel_of(centre_m);
   const Index3 nb = geometry.bricks();

@@ -64,6 +64,15 @@ class ShiftingMap {
   template <typename VoxelsOf>
   void spill(const std::vector<tsdf::Index3>& bricks, const VoxelsOf& voxels_of);
   void load(const std::vector<tsdf::Index3>& bricks, std::vector<uint32_t>& voxels);
+  /// Reads `bricks` from the local map and spills them, a batch of whole chunks at a time:
+  /// never more than a batch of the map copied at once.
+  void spill_from_map(const std::vector<tsdf::Index3>& bricks);
+  /// The bricks of `bricks` whose chunk the store holds (`stored`, their voxels in that
+  /// order) and the others (`absent`).
+  void load_stored(const std::vector<tsdf::Index3>& bricks, std::vector<tsdf::Index3>& stored,
+                   std::vector<uint32_t>& voxels, std::vector<tsdf::Index3>& absent);
+  /// Overwrites `bricks` of the local map with unobserved voxels, a few MB at a time.
+  void clear_bricks(const std::vector<tsdf::Index3>& bricks);
   bool unchanged_in_store(const ChunkKey& key, uint64_t digest) const;
 
   tsdf::Integrator& map_;
@@ -72,7 +81,8 @@ class ShiftingMap {
   std::set<ChunkKey> keys_at_open_;                               ///< digests unknown
   std::unordered_map<ChunkKey, uint64_t, ChunkKeyHash> written_;  ///< digest of the last write
   ShiftingMapStats stats_;
-  tsdf::ShiftBuffers shift_buffers_;   ///< kept between shifts
+  std::vector<uint32_t> slab_;         ///< bricks on their way in or out, kept between shifts
+  std::vector<uint32_t> unobserved_;   ///< unobserved voxels to clear entering bricks with
   std::vector<uint32_t> read_inside_;  ///< read_blocks' bricks, kept between calls
   std::vector<uint32_t> read_outside_;
 };

@@ -49,7 +49,7 @@ class Integrator {
   /// Moves the local map's lowest corner to `origin` (a multiple of kBrickSize) without
   /// touching any voxel: the bricks the old and the new box share keep their voxels, and the
   /// ring-buffer slots of the bricks that left now hold stale voxels for the bricks that
-  /// entered. Use shift_local_map(), which fills them.
+  /// entered. storage::ShiftingMap fills them.
   virtual void set_origin(Index3 origin) = 0;
 };
 
