@@ -13,7 +13,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "featsense/mesh/mesh_simplification.hpp"
 #include "featsense/viewer_export/mesh_nav_h5_io.hpp"
 #include "featsense/viewer_export/mesh_writer.hpp"
 #include "featsense/viewer_export/surface_file_regions.hpp"
@@ -117,7 +116,7 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
     for (const mesh::TriangleMesh& part : near) parts.push_back(&part);
     // A vertex on a cut has its faces on both sides (for normals computed from faces) and its
     // neighbours across it (roughness, height difference).
-    const mesh::TriangleMesh welded = mesh::weld_by_position(parts);
+    const mesh::TriangleMesh welded = reader.weld(parts);
     const std::size_t own = own_tile->triangles.size();
     near.clear();
     const mesh::NavigationLayers layers = mesh::compute_navigation_layers(welded, settings);

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <vector>
@@ -230,6 +232,50 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
   EXPECT_GE(compared, whole.size());  // the cuts' vertices in two tiles
   EXPECT_GT(lethal, 0u);
   EXPECT_LT(lethal, compared);
+  // The same from GLB tiles alone, whose copies of a cut's vertex come back a float rounding
+  // apart: welded all the same, the cuts' layers are the whole mesh's too.
+  result =
+      run_featsense("navmesh " + (dir / "q").string() + " -o " + (dir / "nav_q").string() + limits);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::map<std::array<long, 3>, std::vector<std::pair<Key, const std::vector<float>*>>> grid;
+  const auto cell_of = [](const Key& p, int dx, int dy, int dz) {
+    return std::array<long, 3>{std::lround(std::floor(p[0] * 1000.0f)) + dx,
+                               std::lround(std::floor(p[1] * 1000.0f)) + dy,
+                               std::lround(std::floor(p[2] * 1000.0f)) + dz};
+  };
+  for (const auto& [position, values] : whole)
+    grid[cell_of(position, 0, 0, 0)].push_back({position, &values});
+  size_t compared_glb = 0;
+  double worst_deg = 0.0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "nav_q")) {
+    if (entry.path().extension() != ".ply") continue;
+    for (const auto& [position, values] : layers_by_position(entry.path())) {
+      const std::vector<float>* nearest = nullptr;
+      double nearest_m = 1e-4;  // within 0.1 mm of a vertex of the whole mesh
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto found = grid.find(cell_of(position, dx, dy, dz));
+            if (found == grid.end()) continue;
+            for (const auto& [p, v] : found->second) {
+              const double d =
+                  std::hypot(p[0] - position[0], p[1] - position[1], p[2] - position[2]);
+              if (d < nearest_m) {
+                nearest_m = d;
+                nearest = v;
+              }
+            }
+          }
+      ASSERT_NE(nearest, nullptr) << "a GLB tile's vertex is not in the whole mesh";
+      ASSERT_EQ(values.size(), nearest->size());
+      for (size_t k = 0; k + 1 < values.size(); ++k)
+        worst_deg = std::max(worst_deg, static_cast<double>(std::abs(values[k] - (*nearest)[k])));
+      EXPECT_EQ(values.back(), nearest->back()) << "lethal";
+      ++compared_glb;
+    }
+  }
+  EXPECT_EQ(compared_glb, compared);
+  EXPECT_LT(worst_deg, 1e-2);
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "nav" / "navmesh.json"));
   result = run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav.ply").string());
   EXPECT_NE(result.exit_code, 0);

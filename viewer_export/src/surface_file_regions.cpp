@@ -91,10 +91,7 @@ class TileSetRegions final : public mesh::SurfaceRegions {
  public:
   TileSetRegions(const fs::path& dir, std::size_t cached_tiles) : reader_(dir, cached_tiles) {
     bounds_.setEmpty();
-    for (const TileSetEntry& entry : reader_.tiles()) {
-      bounds_.extend(entry.bounds);
-      glb_ = glb_ || mesh_extension(entry.file) != ".ply";
-    }
+    for (const TileSetEntry& entry : reader_.tiles()) bounds_.extend(entry.bounds);
   }
 
   Eigen::AlignedBox3d bounds() const override { return bounds_; }
@@ -112,16 +109,13 @@ class TileSetRegions final : public mesh::SurfaceRegions {
     for (const mesh::TriangleMesh& part : clipped) parts.push_back(&part);
     mesh::SurfacePiece piece;
     if (parts.empty()) return piece;
-    // The tiles' copies of a vertex on a cut are one vertex, as in the whole map's mesh: the
-    // same position in PLY tiles, within a rounding in GLB ones.
-    piece.mesh = mesh::weld_by_position(parts);
-    if (glb_) piece.mesh = weld_within(piece.mesh, kGlbWeldM);
+    // The tiles' copies of a vertex on a cut are one vertex, as in the whole map's mesh.
+    piece.mesh = reader_.weld(parts);
     return piece;
   }
 
  private:
   TileSetReader reader_;
-  bool glb_ = false;  ///< some tiles are GLB only
   Eigen::AlignedBox3d bounds_;
 };
 
@@ -158,7 +152,14 @@ std::vector<TileSetEntry> read_tile_set_index(const fs::path& dir) {
 TileSetReader::TileSetReader(fs::path dir, std::size_t cached_tiles)
     : dir_(std::move(dir)),
       tiles_(read_tile_set_index(dir_)),
-      cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {}
+      cached_tiles_(std::max<std::size_t>(cached_tiles, 1)) {
+  for (const TileSetEntry& entry : tiles_) glb_ = glb_ || mesh_extension(entry.file) != ".ply";
+}
+
+mesh::TriangleMesh TileSetReader::weld(const std::vector<const mesh::TriangleMesh*>& parts) const {
+  mesh::TriangleMesh welded = mesh::weld_by_position(parts);
+  return glb_ ? weld_within(welded, kGlbWeldM) : welded;
+}
 
 std::shared_ptr<const mesh::TriangleMesh> TileSetReader::tile(std::size_t i) const {
   {

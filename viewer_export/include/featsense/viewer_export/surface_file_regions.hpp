@@ -37,10 +37,16 @@ class TileSetReader {
   const std::vector<TileSetEntry>& tiles() const { return tiles_; }
   /// Tile `i` of tiles(), from the cache or from its file.
   std::shared_ptr<const mesh::TriangleMesh> tile(std::size_t i) const;
+  /// Parts of this set's tiles as one mesh, the parts' triangles in order, with the copies of
+  /// a vertex on a cut between tiles once, as in the whole map's mesh: the same position in
+  /// PLY tiles, within 10 micrometres where tiles are GLB only (stored re-centred, so the
+  /// copies come back a float rounding apart).
+  mesh::TriangleMesh weld(const std::vector<const mesh::TriangleMesh*>& parts) const;
 
  private:
   std::filesystem::path dir_;
   std::vector<TileSetEntry> tiles_;
+  bool glb_ = false;  ///< some tiles are GLB only
   std::size_t cached_tiles_;
   // The cache is not the tile set's state: reading stays const.
   mutable std::map<std::size_t, std::shared_ptr<const mesh::TriangleMesh>> cache_;
