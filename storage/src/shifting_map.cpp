@@ -38,11 +38,6 @@ Index3 brick_corner_in_chunk(Index3 brick, const ChunkKey& key) {
           brick.z * kBrickSize - key.z * kChunkSize};
 }
 
-/// x-fastest order of bricks (as tsdf::bricks_of lists them).
-bool brick_less(const Index3& a, const Index3& b) {
-  return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
-}
-
 /// The voxels of a batch of chunks (32 MB at most) or of the stored bricks that enter the
 /// local map: kept from one shift to the next up to this size, so that its pages are not
 /// faulted in and cleared each time.
@@ -198,10 +193,6 @@ bool ShiftingMap::move_to(Index3 origin) {
   tsdf::LocalMapGeometry target = map_.geometry();
   target.origin = origin;
   const tsdf::BrickExchange exchange = tsdf::exchanged_bricks(map_.geometry(), target);
-  if (exchange.leaving.empty()) {
-    map_.set_origin(origin);
-    return true;
-  }
   // The bricks that leave go into the store first, a few chunks at a time, while the map
   // still holds them: a failing write leaves the map whole where it was. (A chunk that holds
   // both leaving and entering bricks is read back below with the leaving ones merged in;
@@ -293,6 +284,9 @@ void ShiftingMap::read_blocks(const std::vector<Index3>& origins, Index3 dim,
   std::vector<Index3> bricks;
   for (const Index3& origin : origins)
     for_each_brick_in_box(origin, dim, [&](Index3 b) { bricks.push_back(b); });
+  const auto brick_less = [](const Index3& a, const Index3& b) {
+    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
+  };
   std::sort(bricks.begin(), bricks.end(), brick_less);
   bricks.erase(std::unique(bricks.begin(), bricks.end(),
                            [](const Index3& a, const Index3& b) {
