@@ -157,8 +157,8 @@ TileSetReader::TileSetReader(fs::path dir, std::size_t cached_tiles)
 }
 
 mesh::TriangleMesh TileSetReader::weld(const std::vector<const mesh::TriangleMesh*>& parts) const {
-  mesh::TriangleMesh welded = mesh::weld_by_position(parts);
-  return glb_ ? weld_within(welded, kGlbWeldM) : welded;
+  if (glb_) return weld_within(mesh::weld_by_position(parts), kGlbWeldM);
+  return mesh::weld_by_position(parts);
 }
 
 std::shared_ptr<const mesh::TriangleMesh> TileSetReader::tile(std::size_t i) const {
