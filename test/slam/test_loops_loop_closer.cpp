@@ -124,6 +124,19 @@ TEST(LoopCloser, ClosesLoopsDrivenTheOtherWayAndCorrectsTheDrift) {
                     .isApprox(closer.graph().pose(i), 1e-6));
   }
   EXPECT_GT(closer.counts().cloud_bytes, 0u);
+  // At the end of a run the records take the clouds over: the same records, one copy.
+  const std::vector<KeyframeRecord> copied = closer.keyframe_records();
+  const std::vector<KeyframeRecord> released = closer.release_keyframe_records();
+  ASSERT_EQ(released.size(), copied.size());
+  size_t bytes = 0;
+  for (size_t i = 0; i < copied.size(); ++i) {
+    EXPECT_EQ(released[i].stamp_ns, copied[i].stamp_ns);
+    EXPECT_TRUE(released[i].T_map_sensor.isApprox(copied[i].T_map_sensor, 0.0));
+    EXPECT_EQ(released[i].cloud.coordinates(), copied[i].cloud.coordinates());
+    bytes += released[i].cloud.bytes();
+  }
+  EXPECT_EQ(bytes, closer.counts().cloud_bytes);
+  for (const KeyframeRecord& left : closer.keyframe_records()) EXPECT_EQ(left.cloud.size(), 0u);
 }
 
 TEST(LoopCloser, OnlyTrueLoopsWhereTheLaneLooksAlikeEverywhere) {

@@ -432,4 +432,16 @@ std::vector<KeyframeRecord> LoopCloser::keyframe_records() const {
   return records;
 }
 
+std::vector<KeyframeRecord> LoopCloser::release_keyframe_records() {
+  std::vector<KeyframeRecord> records;
+  records.reserve(keyframes_.size());
+  for (size_t i = 0; i < keyframes_.size(); ++i) {
+    Keyframe& keyframe = keyframes_[i];
+    records.push_back({keyframe.stamp_ns, keyframe.travelled_m, graph_.pose(i), keyframe.descriptor,
+                       std::move(keyframe.cloud)});
+    keyframe.cloud = CompactCloud();
+  }
+  return records;
+}
+
 }  // namespace featsense::slam::loops

@@ -109,7 +109,7 @@ LoopOutcome LoopStage::finish() {
   out.gravity = out.final_optimisation.gravity;
   out.loops = closer_.loops();
   out.counts = closer_.counts();
-  out.keyframes = closer_.keyframe_records();
+  out.keyframes = closer_.release_keyframe_records();  // one copy of the clouds, not two
   out.keyframe_queue_wait_ms = wait_ms_;
   if (relocalize_) {
     out.relocalization = relocalize_->relocalizer->placement();

@@ -208,6 +208,11 @@ class LoopCloser {
   size_t keyframes() const { return keyframes_.size(); }
   /// Every keyframe in order, at the graph's current pose.
   std::vector<KeyframeRecord> keyframe_records() const;
+  /// keyframe_records() with the clouds moved out of the closer, for the end of a run: the
+  /// clouds are most of a long run's keyframes (80 MB a kilometre of city), and a copy of them
+  /// would be held as long as the records are. Keyframes added later, and the loops they
+  /// search, see these keyframes without points.
+  std::vector<KeyframeRecord> release_keyframe_records();
   const std::vector<LoopRecord>& loops() const { return loops_; }
   const LoopCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
