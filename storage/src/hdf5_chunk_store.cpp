@@ -343,7 +343,14 @@ void Hdf5ChunkStore::flush() {
   }
   journal_keyframes_and_sessions();
   journal_->sync();
-  if (journal_->size_bytes() > settings_.journal_limit_bytes) checkpoint();
+  if (journal_->size_bytes() > fold_threshold_bytes()) checkpoint();
+}
+
+std::size_t Hdf5ChunkStore::fold_threshold_bytes() const {
+  std::error_code error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path_, error);
+  const std::size_t half_file = error ? 0 : static_cast<std::size_t>(file_bytes / 2);
+  return std::max(settings_.journal_limit_bytes, half_file);
 }
 
 void Hdf5ChunkStore::checkpoint() {

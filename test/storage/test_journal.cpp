@@ -127,6 +127,39 @@ TEST(Journal, GrowingPastItsLimitFoldsIntoTheH5) {
     EXPECT_TRUE(*store.read(key) == make_chunk(static_cast<uint32_t>(key.x)));
 }
 
+TEST(Journal, FoldsCostInProportionToWhatWasJournalled) {
+  // Each fold rewrites the whole .h5. With a fixed journal limit a map of n chunks written one
+  // by one was rewritten about n times (n^2 / 2 chunks copied); folding only once the journal
+  // is also half the file copies each journalled chunk a bounded number of times.
+  const auto path = test::scratch_dir("journal_amortized") / "map.h5";
+  StoreSettings settings = no_checkpoint();
+  settings.journal_limit_bytes = 64u << 10;
+  constexpr uint32_t kChunks = 40;
+  Hdf5ChunkStore store(path, OpenMode::kCreate, test_metadata(), settings);
+  std::uintmax_t rewritten = 0, last_size = std::filesystem::file_size(path);
+  int folds = 0;
+  for (uint32_t i = 0; i < kChunks; ++i) {
+    store.write({static_cast<int32_t>(i), 0, 0}, make_chunk(i));
+    store.flush();
+    const std::uintmax_t size = std::filesystem::file_size(path);
+    if (size != last_size) {  // only a fold writes the .h5
+      ++folds;
+      rewritten += size;
+    } else {
+      EXPECT_LE(store.journal_bytes(),
+                std::max<std::uintmax_t>(settings.journal_limit_bytes, last_size / 2));
+    }
+    last_size = size;
+  }
+  // Every chunk is about 1 MB stored, so each write passes the fixed limit: 40 folds and 820
+  // chunks rewritten before; now 7 folds (at 1, 2, 4, 7, 11, 17 and 26 chunks), 68 rewritten.
+  EXPECT_GT(last_size, kChunks * 100000u);
+  EXPECT_LE(folds, 10);
+  EXPECT_LE(rewritten, 3 * last_size);
+  for (uint32_t i = 0; i < kChunks; i += 7)
+    EXPECT_TRUE(*store.read({static_cast<int32_t>(i), 0, 0}) == make_chunk(i));
+}
+
 TEST(Journal, ForeignJournalIsAnError) {
   const auto path = test::scratch_dir("journal_foreign") / "map.h5";
   { Hdf5ChunkStore store(path, OpenMode::kCreate, test_metadata()); }

@@ -37,7 +37,10 @@ enum class OpenMode {
 
 struct StoreSettings {
   std::size_t cache_bytes = std::size_t{256} << 20;  ///< LRU limit, bytes (>= one chunk kept)
-  /// A flush folds the journal into the .h5 once the journal is this large, bytes.
+  /// A flush folds the journal into the .h5 once the journal is this large, bytes, and also
+  /// larger than half the .h5: a fold rewrites the whole file, so a journal that may grow with
+  /// the file keeps the folds' cost in proportion to what was journalled (each journalled byte
+  /// is written at most three times), where a fixed limit made a long route's map quadratic.
   std::size_t journal_limit_bytes = std::size_t{512} << 20;
   /// Fold the journal into the .h5 at close. Off only to leave the map as a crash would.
   bool checkpoint_on_close = true;
@@ -143,6 +146,8 @@ class Hdf5ChunkStore final : public ChunkStore {
   /// Appends the unflushed keyframes and, when changed, the sessions table to the journal.
   void journal_keyframes_and_sessions();
   bool has_unflushed_writes() const;
+  /// The journal's size beyond which a flush checkpoints (see journal_limit_bytes).
+  std::size_t fold_threshold_bytes() const;
   /// Puts a durable chunk into `writer`: copied as stored from the .h5, else decoded from the
   /// journal and encoded again.
   void write_durable_chunk(detail::Hdf5MapWriter& writer, const ChunkKey& key) const;
