@@ -30,10 +30,9 @@ struct ValidatorRun {
   std::string output;  ///< one JSON report per file
 };
 
-/// Runs the Khronos validator (test/tools/validate_gltf.mjs) on `path`.
-inline ValidatorRun run_validator(const std::string& path) {
-  const std::string command =
-      "node " + (tools_dir() / "validate_gltf.mjs").string() + " " + path + " 2>&1";
+/// Runs node on test/tools/`script` with `arguments`; its output is stdout and stderr together.
+inline ValidatorRun run_node_tool(const std::string& script, const std::string& arguments) {
+  const std::string command = "node " + (tools_dir() / script).string() + " " + arguments + " 2>&1";
   ValidatorRun run;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -43,6 +42,17 @@ inline ValidatorRun run_validator(const std::string& path) {
   const int status = pclose(pipe);
   run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
+}
+
+/// Runs the Khronos validator (test/tools/validate_gltf.mjs) on `path`.
+inline ValidatorRun run_validator(const std::string& path) {
+  return run_node_tool("validate_gltf.mjs", path);
+}
+
+/// Checks a tile set (test/tools/check_tileset.mjs: 3D Tiles 1.1's rules, and the Khronos
+/// validator on every GLB content unless `gltf` is false); one JSON line comes back.
+inline ValidatorRun run_tileset_check(const std::string& tileset_json, bool gltf = true) {
+  return run_node_tool("check_tileset.mjs", tileset_json + (gltf ? "" : " --no-gltf"));
 }
 
 /// Runs the Khronos validator on `path` where it is installed (GltfValidator.RejectsABrokenFile

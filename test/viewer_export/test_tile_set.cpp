@@ -2,15 +2,18 @@
 // their children and content, geometric errors falling to 0 at the full-resolution tiles,
 // content that exists), the full-resolution tiles hold the whole map's mesh, parents fewer
 // triangles than their children, the index lists the tiles, the GLBs pass the Khronos
-// validator, and the files are the same whatever the threads.
+// validator, the set passes test/tools/check_tileset.mjs (which finds each rule broken on
+// purpose), and the files are the same whatever the threads.
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -128,6 +131,72 @@ TEST(TileSet, TilesetKeepsTheRulesAndTheTilesHoldTheWholeMesh) {
 
   expect_valid((dir / root["content"]["uri"].get<std::string>()).string());
   expect_valid((dir / "tiles/0/0_0.glb").string());
+}
+
+/// Runs test/tools/check_tileset.mjs on dir/tileset.json (with the Khronos validator on the
+/// GLBs where `gltf`): its exit status and its report.
+std::pair<int, nlohmann::json> check_tileset(const fs::path& dir, bool gltf = true) {
+  const ValidatorRun run = run_tileset_check((dir / "tileset.json").string(), gltf);
+  nlohmann::json report;
+  try {
+    report = nlohmann::json::parse(run.output);
+  } catch (const nlohmann::json::exception&) {
+    ADD_FAILURE() << "check_tileset.mjs did not print one JSON line: " << run.output;
+  }
+  return {run.status, report};
+}
+
+void rewrite_tileset(const fs::path& dir, const std::function<void(nlohmann::json&)>& change) {
+  nlohmann::json tileset;
+  std::ifstream(dir / "tileset.json") >> tileset;
+  change(tileset);
+  std::ofstream(dir / "tileset.json") << tileset.dump(1);
+}
+
+TEST(TileSet, TheTilesetCheckerPassesTheSetAndFindsEachBrokenRule) {
+  // The 3D Tiles rules a streaming viewer relies on, checked on the files by a program of their
+  // own (test/tools/check_tileset.mjs, the Khronos validator on every GLB), the same that
+  // checks the large tile sets of the benchmarks; each rule broken on purpose is found.
+  if (!validator_present())
+    GTEST_SKIP() << "node or gltf-validator missing (npm install in test/tools)";
+  storage::MemoryChunkStore store = tile_scene_store();
+  const fs::path dir = scratch_dir("tile_set_checked");
+  viewer_export::TileSetSettings settings;
+  settings.tile_size_m = 3.0;
+  settings.write_ply = false;
+  viewer_export::write_tile_set(store, dir.string(), settings);
+  const auto [status, report] = check_tileset(dir);
+  EXPECT_EQ(status, 0) << report.dump(1);
+  EXPECT_EQ(report["tiles"], 21);  // 16 + 4 + 1
+  EXPECT_EQ(report["contents"], 21);
+  EXPECT_EQ(report["gltf_validated"], 21);
+  EXPECT_EQ(report["error_count"], 0) << report.dump(1);
+  const std::string original = file_bytes(dir / "tileset.json");
+
+  const auto expect_found = [&](const std::string& what, const std::string& words) {
+    const auto [broken_status, broken] = check_tileset(dir, false);  // the rules alone
+    EXPECT_EQ(broken_status, 1) << what;
+    EXPECT_NE(broken.dump().find(words), std::string::npos) << what << ": " << broken.dump(1);
+    std::ofstream(dir / "tileset.json") << original;
+  };
+  rewrite_tileset(dir, [](nlohmann::json& t) {
+    t["root"]["children"][0]["geometricError"] = t["root"]["geometricError"].get<double>() + 1.0;
+  });
+  expect_found("a child coarser than its parent", "above its parent's");
+  rewrite_tileset(dir, [](nlohmann::json& t) {
+    t["root"]["children"][1]["children"][2]["boundingVolume"]["box"][0] = 100.0;
+  });
+  expect_found("a tile moved away from its content", "reaches outside");
+  rewrite_tileset(dir, [](nlohmann::json& t) { t["root"].erase("refine"); });
+  expect_found("a root without refine", "the root has no refine");
+  rewrite_tileset(dir, [](nlohmann::json& t) { t["root"]["boundingVolume"]["box"].erase(11); });
+  expect_found("a box of 11 numbers", "box is not 12 finite numbers");
+  const std::string leaf = "tiles/0/0_0.glb";
+  const std::string glb = file_bytes(dir / leaf);
+  fs::remove(dir / leaf);
+  expect_found("a missing content", "does not exist");
+  std::ofstream(dir / leaf, std::ios::binary) << glb.substr(0, glb.size() / 2);
+  expect_found("a truncated GLB", "GLB length");
 }
 
 TEST(TileSet, LevelsAreAddedAboveTheRootUntilItIsSmallEnough) {
