@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <numeric>
@@ -18,6 +19,7 @@
 #include "featsense/viewer_export/surface_file_regions.hpp"
 #include "json_output.hpp"
 #include "progress.hpp"
+#include "tile_margins.hpp"
 
 namespace featsense::app {
 namespace {
@@ -87,14 +89,13 @@ std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& m
 nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::path& out_dir,
                                       const std::string& extension,
                                       const mesh::NavigationSettings& settings, bool quiet) {
-  // A tile and the parts of its (up to) eight neighbours within the radius at a time, a few
-  // tiles at once. Memory is mostly the reader's cache (25 MB a city tile): 8 tiles a worker
-  // keep most tiles to one read (16 on 2 cores: 2 min 37 s and 0.79 GB for the 2.5 km city's
-  // 104 tiles; 8: 3 min 47 s, 0.68 GB; 32: 2 min 21 s, 1.22 GB), and at most 4 threads
-  // (a tile's own work takes 0.2 GB more) keep it under 2 GB on any machine.
+  // Two passes over the tiles, a few tiles at once (at most 4 threads: a tile's work takes
+  // about 0.2 GB): the first cuts from each tile the triangles its neighbours need and keeps
+  // them on disk (TileMargins); the second computes each tile's layers with those parts of its
+  // neighbours. Every tile is read twice, and memory is that of the tiles in work.
   const std::size_t workers =
       std::clamp<std::size_t>(static_cast<std::size_t>(tbb::info::default_concurrency()), 1, 4);
-  const viewer_export::TileSetReader reader(tile_set_dir, 8 * workers);
+  const viewer_export::TileSetReader reader(tile_set_dir, workers);
   const std::vector<viewer_export::TileSetEntry>& tiles = reader.tiles();
   fs::create_directories(out_dir);
   // A tile's vertex looks at the vertices within the radius and at their normals, made from
@@ -102,16 +103,23 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   // a vertex in that box meets the box: the triangles meeting it are all the layers need.
   // (The centimetre covers the float rounding of the radius test.)
   const double reach = settings.radius_m + 0.01;
+  const auto around = [&](std::size_t i) {
+    return Eigen::AlignedBox3d(tiles[i].bounds.min().array() - reach,
+                               tiles[i].bounds.max().array() + reach);
+  };
+  TileMargins margins(out_dir / ".margins");
+  const auto cut_margins = [&](std::size_t j) {
+    const std::shared_ptr<const mesh::TriangleMesh> tile = reader.tile(j);
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+      if (i == j || !tiles[j].bounds.intersects(around(i))) continue;
+      const mesh::TriangleMesh part = mesh::triangles_meeting(*tile, around(i));
+      if (!part.triangles.empty()) margins.put(i, j, part);
+    }
+  };
   const auto navigate_tile = [&](std::size_t i) -> nlohmann::json {
     // The tile first, then its neighbours' parts: welded, the tile's triangles stay the first.
-    const Eigen::AlignedBox3d around(tiles[i].bounds.min().array() - reach,
-                                     tiles[i].bounds.max().array() + reach);
-    std::vector<mesh::TriangleMesh> near;
     const std::shared_ptr<const mesh::TriangleMesh> own_tile = reader.tile(i);
-    for (std::size_t j = 0; j < tiles.size(); ++j) {
-      if (j != i && tiles[j].bounds.intersects(around))
-        near.push_back(mesh::triangles_meeting(*reader.tile(j), around));
-    }
+    std::vector<mesh::TriangleMesh> near = margins.take(i);
     std::vector<const mesh::TriangleMesh*> parts{own_tile.get()};
     for (const mesh::TriangleMesh& part : near) parts.push_back(&part);
     // A vertex on a cut has its faces on both sides (for normals computed from faces) and its
@@ -136,19 +144,23 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   // Each tile's file depends on the tile set alone, so the order of the work does not matter;
   // the index lists the tiles in the tile set's order.
   std::vector<nlohmann::json> entries(tiles.size());
-  Progress progress("navmesh", tiles.size(), quiet);
+  Progress progress("navmesh", 2 * tiles.size(), quiet);
   std::mutex progress_mutex;
   std::size_t done = 0;
-  tbb::task_arena arena(static_cast<int>(workers));
-  arena.execute([&] {
+  const auto for_each_tile = [&](const std::function<void(std::size_t)>& work) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.size(), 1),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                          entries[i] = navigate_tile(i);
+                          work(i);
                           const std::lock_guard<std::mutex> lock(progress_mutex);
                           progress.update(++done);
                         }
                       });
+  };
+  tbb::task_arena arena(static_cast<int>(workers));
+  arena.execute([&] {
+    for_each_tile(cut_margins);
+    for_each_tile([&](std::size_t i) { entries[i] = navigate_tile(i); });
   });
   progress.finish();
   nlohmann::json listed = nlohmann::json::array();

@@ -24,8 +24,9 @@ std::size_t write_navigation_mesh(const std::string& path, mesh::TriangleMesh& m
 /// `out_dir` (X_Y.EXT, EXT from `extension`: ".ply", ".glb", ...) and `navmesh.json` (the
 /// tiles, their triangles and lethal ones, the settings). Each tile is computed with the
 /// triangles of the tiles around it within the radius, welded by position, so that its
-/// border vertices have the neighbourhoods and normals they have in the whole mesh; memory is
-/// that of the reader's cache (8 tiles a thread, at most 4 threads) and of the tiles in work.
+/// border vertices have the neighbourhoods and normals they have in the whole mesh. Those
+/// parts are cut from each tile in a first pass and kept in `out_dir`/.margins until used, so
+/// every tile is read twice and memory is that of the tiles in work (at most 4 threads).
 /// Returns navmesh.json's content.
 nlohmann::json write_navigation_tiles(const std::filesystem::path& tile_set_dir,
                                       const std::filesystem::path& out_dir,

@@ -277,6 +277,7 @@ TEST(CliMesh, WritesATileSetBesideOrInsteadOfOneMesh) {
   EXPECT_EQ(compared_glb, compared);
   EXPECT_LT(worst_deg, 1e-2);
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "nav" / "navmesh.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "nav" / ".margins")) << "the tiles' parts are left";
   result = run_featsense("navmesh " + (dir / "t").string() + " -o " + (dir / "nav.ply").string());
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("-o names a folder"), std::string::npos) << result.output;
