@@ -29,7 +29,24 @@ mkdir -p "$work"
 timed() {  # timed KM NAME COMMAND...
   local km=$1 name=$2
   shift 2
-  /usr/bin/time -v -o "$work/$km.$name.time.txt" "$@"
+  if [ -x /usr/bin/time ]; then
+    /usr/bin/time -v -o "$work/$km.$name.time.txt" "$@"
+    return
+  fi
+  # Machines without GNU time (the GPU machine): the same two lines from the kernel's
+  # accounting of the finished child (ru_maxrss is in kilobytes on Linux).
+  python3 - "$work/$km.$name.time.txt" "$@" <<'PY'
+import resource, subprocess, sys, time
+start = time.monotonic()
+status = subprocess.call(sys.argv[2:])
+wall = time.monotonic() - start
+peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+with open(sys.argv[1], "w") as out:
+    out.write("\tElapsed (wall clock) time (h:mm:ss or m:ss): %d:%05.2f\n" % divmod(wall, 60))
+    out.write("\tMaximum resident set size (kbytes): %d\n" % peak_kb)
+    out.write("\tExit status: %d\n" % status)
+sys.exit(status)
+PY
 }
 
 for km in "${routes[@]}"; do
