@@ -46,6 +46,7 @@ struct MeshOptions {
   std::optional<std::string> trajectory_path;  ///< the path drawn on it (and its cut)
   std::optional<std::string> tiles_dir;        ///< the tile set's folder
   double tile_size_m = viewer_export::TileSetSettings{}.tile_size_m;
+  std::size_t tiles_in_work = viewer_export::TileSetSettings{}.tiles_in_work;
   bool tile_ply = true;
   bool quiet = false;
 };
@@ -261,6 +262,7 @@ void run_mesh(const MeshOptions& options) {
     tiling.tile_size_m = options.tile_size_m;
     tiling.meshing = run.settings;
     tiling.write_ply = options.tile_ply;
+    tiling.tiles_in_work = options.tiles_in_work;
     if (options.clean) {
       mesh::CleanupSettings cleaning;
       cleaning.min_component_area_m2 = options.min_component_area_m2;
@@ -332,6 +334,12 @@ Command register_mesh(CLI::App& app, const CliContext& context) {
                    "With --tiles: edge of a tile, metres (rounded to whole chunks)")
       ->capture_default_str();
   command->add_flag("!--no-tile-ply", options->tile_ply, "With --tiles: GLB only, no PLY per tile");
+  command
+      ->add_option("--tiles-in-work", options->tiles_in_work,
+                   "With --tiles: tiles cleaned and written at once, each up to about 1 GB for "
+                   "a dense 50 m tile (the marching cubes use --threads)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   command->add_option("--bbox", options->bbox,
                       "Only this box: xmin,ymin,zmin,xmax,ymax,zmax (metres, map frame)");
   command

@@ -270,6 +270,7 @@ TEST(TileSet, TheFilesAndTheOverviewDoNotDependOnTheThreads) {
     const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
     one_thread = viewer_export::write_tile_set(store, one_dir.string(), settings);
   }
+  settings.tiles_in_work = 8;  // as many tiles finished at once as there are tiles
   const viewer_export::TileSetReport all =
       viewer_export::write_tile_set(store, all_dir.string(), settings);
   const auto expected = files_of(one_dir);
@@ -305,6 +306,9 @@ TEST(TileSet, OneTileIsItsOwnRootAndBadInputIsRefused) {
   settings.level_ratio = 1.0;
   EXPECT_THROW(viewer_export::write_tile_set(store, dir.string(), settings), std::invalid_argument);
   settings.level_ratio = 0.25;
+  settings.tiles_in_work = 0;
+  EXPECT_THROW(viewer_export::write_tile_set(store, dir.string(), settings), std::invalid_argument);
+  settings.tiles_in_work = 2;
   settings.tile_size_m = -1.0;
   EXPECT_THROW(viewer_export::write_tile_set(store, dir.string(), settings), std::invalid_argument);
   storage::MemoryChunkStore empty(test_metadata(kTileSceneVoxel, kTileSceneTau));

@@ -2,8 +2,9 @@
 // built depth first (each parent as soon as its children are done), the index and the
 // tileset written at the end. Meshing reads the store and runs on the caller's thread (it is
 // parallel within); what follows it for a node (cleanup, files, the share for its parent)
-// runs as a task beside the meshing of the next tiles.
+// runs as a task beside the meshing of the next tiles, a bounded number at once.
 
+#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 #include <nlohmann/json.hpp>
 
@@ -443,8 +444,15 @@ TileSetReport write_tile_set(storage::ChunkStore& store, const std::string& dir,
         "triangles, got " +
         std::to_string(settings.level_ratio));
   }
+  if (settings.tiles_in_work < 1 || settings.tiles_in_work > 1024) {
+    throw std::invalid_argument("tile set: tiles in work must be 1 to 1024, got " +
+                                std::to_string(settings.tiles_in_work));
+  }
   fs::create_directories(dir);
-  return TileSetBuilder(store, dir, settings).build();
+  // The builder's tasks run in an arena of that many threads, this one among them; the
+  // marching cubes open their own arena and take every core they are given.
+  tbb::task_arena arena(static_cast<int>(settings.tiles_in_work));
+  return arena.execute([&] { return TileSetBuilder(store, dir, settings).build(); });
 }
 
 }  // namespace featsense::viewer_export
