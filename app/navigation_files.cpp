@@ -111,8 +111,10 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   const auto cut_margins = [&](std::size_t j) {
     const std::shared_ptr<const mesh::TriangleMesh> tile = reader.tile(j);
     for (std::size_t i = 0; i < tiles.size(); ++i) {
-      if (i == j || !tiles[j].bounds.intersects(around(i))) continue;
-      const mesh::TriangleMesh part = mesh::triangles_meeting(*tile, around(i));
+      if (i == j) continue;
+      const Eigen::AlignedBox3d reach_of_i = around(i);
+      if (!tiles[j].bounds.intersects(reach_of_i)) continue;
+      const mesh::TriangleMesh part = mesh::triangles_meeting(*tile, reach_of_i);
       if (!part.triangles.empty()) margins.put(i, j, part);
     }
   };
