@@ -53,9 +53,10 @@ struct TileSetSettings {
   std::size_t overview_triangles = 0;
   /// Tiles finished at once (cleaned, simplified, written) beside the meshing of the next
   /// ones. Each holds its mesh and its cleanup's work, up to about 1 GB for a dense city tile,
-  /// so this, not the cores, bounds the memory: the GPU machine's 16 cores finished up to five
-  /// at once and peaked at 3.8 GB where 2 cores peaked at 0.9 GB. The marching cubes still use
-  /// `meshing.threads`.
+  /// so this, not the cores, sets how many such tiles are in memory: with one per core, the GPU
+  /// machine's 16 cores peaked at 3.6 GB on the city's first km with cleanup, 2.4 GB with 2
+  /// (2 cores: 0.9 GB; what else grows with the threads is not bounded here). The marching
+  /// cubes still use `meshing.threads`.
   std::size_t tiles_in_work = 2;
   /// Called after each full-resolution tile: tiles done, tiles in all.
   std::function<void(std::size_t, std::size_t)> progress;
