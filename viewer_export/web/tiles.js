@@ -6,14 +6,16 @@
 // `?focus=x,y,z&distance=d` (map frame, metres) starts the camera looking at a point.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { TilesRenderer } from '3d-tiles-renderer';
+import { Scheduler, TilesRenderer } from '3d-tiles-renderer';
 
 const state = { firstFrameMs: null, visible: {}, fullResolutionShown: 0, errors: [] };
 window.featsenseTiles = state;
 
 const container = document.getElementById('scene');
 const status = document.getElementById('status');
-const renderer = new THREE.WebGLRenderer({ antialias: true });
+// No multisampling: on a software rasterizer (a machine without a GPU) it is a large share of
+// every frame's work; the page's other viewer does without it too.
+const renderer = new THREE.WebGLRenderer({ antialias: false });
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.setSize(window.innerWidth, window.innerHeight);
 renderer.setClearColor(0x20242a);
@@ -127,6 +129,7 @@ tiles.addEventListener('load-error', ({ url, error }) => {
 window.addEventListener('resize', () => {
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
+  renderer.setPixelRatio(window.devicePixelRatio);
   renderer.setSize(window.innerWidth, window.innerHeight);
   tiles.setResolutionFromRenderer(camera, renderer);
 });
@@ -142,6 +145,9 @@ function frame() {
   controls.update();
   camera.updateMatrixWorld();
   tiles.update();
+  // The tiles' download and parse queues start their work on the next animation frame; run it
+  // now, so that a tile asked for in this frame is on its way while this frame renders.
+  Scheduler.flushPending();
   renderer.render(scene, camera);
   if (state.firstFrameMs === null && tiles.visibleTiles.size > 0) {
     state.firstFrameMs = performance.now();
