@@ -7,8 +7,11 @@
 //
 // Usage: node page_check.mjs --url URL --screenshot OUT.png [--timeout-ms N]
 //          [--ready-expr 'JS expression'] [--report-expr 'JS expression'] [--width W] [--height H]
+//          [--idle-before-ms N]
 // --report-expr's value (JSON-serializable) comes back as "reported", taken with the
-// screenshot.
+// screenshot. --idle-before-ms: the browser first shows a blank page and stays idle this long
+// before the URL is opened, as a user's browser is running already when they open a page (a
+// browser just launched is still starting its processes; its first page pays for that).
 // `differing_fraction` is the share of pixels whose colour differs from the top-left pixel's
 // (the page's background): a drawn mesh shows as pixels that differ.
 import { existsSync, writeFileSync, mkdtempSync, rmSync } from 'node:fs';
@@ -19,7 +22,8 @@ import { inflateSync } from 'node:zlib';
 const SKIP = 77;
 
 function parseArgs(argv) {
-  const options = { timeoutMs: 30000, readyExpr: '', reportExpr: '', width: 1280, height: 800 };
+  const options = { timeoutMs: 30000, readyExpr: '', reportExpr: '', width: 1280, height: 800,
+                    idleBeforeMs: 0 };
   for (let i = 0; i < argv.length; i += 2) {
     const [key, value] = [argv[i], argv[i + 1]];
     if (value === undefined) throw new Error(`${key} needs a value`);
@@ -30,6 +34,7 @@ function parseArgs(argv) {
     else if (key === '--report-expr') options.reportExpr = value;
     else if (key === '--width') options.width = Number(value);
     else if (key === '--height') options.height = Number(value);
+    else if (key === '--idle-before-ms') options.idleBeforeMs = Number(value);
     else throw new Error(`unknown option ${key}`);
   }
   if (!options.url || !options.screenshot) throw new Error('--url and --screenshot are required');
@@ -134,6 +139,10 @@ try {
   page.on('pageerror', (error) => result.console_errors.push(`uncaught: ${error.message}`));
   page.on('requestfailed', (request) =>
     result.console_errors.push(`request failed: ${request.url()} ${request.failure()?.errorText}`));
+  if (options.idleBeforeMs > 0) {
+    await page.goto('about:blank');
+    await new Promise((resolve) => setTimeout(resolve, options.idleBeforeMs));
+  }
   const start = performance.now();
   await page.goto(options.url, { waitUntil: 'load', timeout: options.timeoutMs });
   if (options.readyExpr)
