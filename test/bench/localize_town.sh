@@ -15,7 +15,12 @@
 # are made where missing. Each run writes WORK/loc_PATH/ (trajectory.tum, localization.csv,
 # report.json with eval against the truth) and WORK/loc_PATH.time.txt (/usr/bin/time -v), and
 # prints one JSON line: the first fix, the scans by status, the errors of the localized poses,
-# tracking time and peak memory. FEATSENSE names the program (default: build/app/featsense).
+# tracking time and peak memory, and the share localized after the first fix by how far the
+# sensor is from the loop's path (the map holds a surface within half of map.size's horizontal
+# extent of where the loop went, 20 m by default; beyond it only the keyframes' points).
+# FEATSENSE names the program (default: build/app/featsense); MAP_DIR the loop map's folder in
+# WORK (default loop_map) and MAP_OPTIONS more options for making it (e.g. "--set
+# map.size=[80,80,15]").
 set -euo pipefail
 work=$1
 shift
@@ -25,8 +30,10 @@ featsense=${FEATSENSE:-build/app/featsense}
 mkdir -p "$work"
 [ -d "$work/town_loop" ] ||
   "$featsense" simulate --quiet --scene town --path loop --seed 4 -o "$work/town_loop"
-[ -f "$work/loop_map/map.h5" ] ||
-  "$featsense" map --quiet "$work/town_loop" -o "$work/loop_map" --no-mesh
+map_dir=$work/${MAP_DIR:-loop_map}
+# shellcheck disable=SC2086  # MAP_OPTIONS is a list of options
+[ -f "$map_dir/map.h5" ] ||
+  "$featsense" map --quiet "$work/town_loop" -o "$map_dir" --no-mesh ${MAP_OPTIONS:-}
 here=$(dirname "$0")
 for path in "${paths[@]}"; do
   scene=town
@@ -48,10 +55,11 @@ for path in "${paths[@]}"; do
     "$featsense" simulate --quiet --scene $scene --path "$route" --seed $seed -o "$work/town_$path"
   rc=0
   /usr/bin/time -v -o "$work/loc_$path.time.txt" "$featsense" localize --quiet \
-    "$work/loop_map/map.h5" "$work/town_$path" -o "$work/loc_$path" \
+    "$map_dir/map.h5" "$work/town_$path" -o "$work/loc_$path" \
     --gt "$work/town_$path/gt_trajectory.tum" || rc=$?
-  python3 - "$work/loc_$path/report.json" "$path" "$rc" <<'PY'
-import json, sys
+  python3 - "$work/loc_$path/report.json" "$path" "$rc" "$work/town_loop/gt_trajectory.tum" \
+    "$work/town_$path/gt_trajectory.tum" "$work/loc_$path/localization.csv" <<'PY'
+import csv, json, math, sys
 r = json.load(open(sys.argv[1]))
 loc, ev, t = r["localization"], r.get("eval", {}), r["timings"]
 fix = loc.get("first_fix", {})
@@ -68,6 +76,29 @@ out = {"path": sys.argv[2], "exit_status": int(sys.argv[3]), "frames": r["frames
                                     if isinstance(v, dict)},
        "search_total_s": t["search_total_s"], "peak_rss_mb": r["peak_rss_mb"],
        "map_cache": r["map_cache"]}
+
+
+def positions(path):
+    return [tuple(map(float, line.split()[1:3])) for line in open(path)
+            if line.strip() and not line.startswith("#")]
+
+
+# The share localized after the first fix, by the sensor's true distance from the loop's path.
+loop = positions(sys.argv[4])[::2]
+rows = list(csv.DictReader(open(sys.argv[6])))
+truth = positions(sys.argv[5])
+bins = {"within_20_m": [0, 0], "20_to_30_m": [0, 0], "beyond_30_m": [0, 0]}
+fixed = False
+for row, (x, y) in zip(rows, truth):
+    fixed = fixed or row["status"] == "localized"
+    if not fixed:
+        continue
+    d = min(math.hypot(x - a, y - b) for a, b in loop)
+    key = "within_20_m" if d <= 20 else "20_to_30_m" if d <= 30 else "beyond_30_m"
+    bins[key][0] += row["status"] == "localized"
+    bins[key][1] += 1
+out["localized_after_first_fix_by_distance_from_loop"] = {
+    k: {"scans": n, "localized": round(l / n, 3)} for k, (l, n) in bins.items() if n}
 print(json.dumps(out))
 PY
 done
