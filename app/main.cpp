@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "featsense/config/config_error.hpp"
 #include "featsense/slam/scan_source.hpp"
+#include "malloc_arenas.hpp"
 #include "stop_signal.hpp"
 
 namespace {
@@ -37,6 +38,7 @@ int fail(const std::string& message, int code) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  featsense::app::limit_malloc_arenas();
   CLI::App app("featsense: LiDAR mapping with a feature-based front end and a TSDF map",
                "featsense");
   app.set_version_flag("--version", "featsense " FEATSENSE_VERSION);
