@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <numeric>
@@ -25,6 +26,21 @@ namespace featsense::app {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// Tile sets whose full-resolution files take at most this much stay in memory whole.
+constexpr std::uintmax_t kKeptWholeBytes = std::uintmax_t{256} << 20;
+
+/// The bytes of the files a TileSetReader reads: the tiles of tiles.json.
+std::uintmax_t full_resolution_bytes(const fs::path& dir) {
+  std::uintmax_t bytes = 0;
+  for (const viewer_export::TileSetEntry& entry : viewer_export::read_tile_set_index(dir)) {
+    std::error_code error;
+    const std::uintmax_t size = fs::file_size(dir / entry.file, error);
+    if (error) return std::numeric_limits<std::uintmax_t>::max();  // the reader says why
+    bytes += size;
+  }
+  return bytes;
+}
 
 /// Green (free) through yellow to red (cost just below 1); lethal vertices dark red.
 Eigen::Matrix<uint8_t, 3, 1> cost_colour(float cost) {
@@ -95,7 +111,12 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   // neighbours. Every tile is read twice, and memory is that of the tiles in work.
   const std::size_t workers =
       std::clamp<std::size_t>(static_cast<std::size_t>(tbb::info::default_concurrency()), 1, 4);
-  const viewer_export::TileSetReader reader(tile_set_dir, workers);
+  // A tile set this small stays in memory from the first pass to the second (its tiles take
+  // about what their files do): read once, not twice.
+  const viewer_export::TileSetReader reader(tile_set_dir,
+                                            full_resolution_bytes(tile_set_dir) <= kKeptWholeBytes
+                                                ? std::numeric_limits<std::size_t>::max()
+                                                : workers);
   const std::vector<viewer_export::TileSetEntry>& tiles = reader.tiles();
   fs::create_directories(out_dir);
   // A tile's vertex looks at the vertices within the radius and at their normals, made from
