@@ -108,11 +108,11 @@ nlohmann::json write_navigation_tiles(const fs::path& tile_set_dir, const fs::pa
   // Two passes over the tiles, a few tiles at once (at most 4 threads: a tile's work takes
   // about 0.2 GB): the first cuts from each tile the triangles its neighbours need and keeps
   // them on disk (TileMargins); the second computes each tile's layers with those parts of its
-  // neighbours. Every tile is read twice, and memory is that of the tiles in work.
+  // neighbours. Every tile is read twice, and memory is that of the tiles in work; except in a
+  // tile set whose files take at most kKeptWholeBytes, which stays in memory from the first pass
+  // to the second (its tiles take about what their files do) and is read once.
   const std::size_t workers =
       std::clamp<std::size_t>(static_cast<std::size_t>(tbb::info::default_concurrency()), 1, 4);
-  // A tile set this small stays in memory from the first pass to the second (its tiles take
-  // about what their files do): read once, not twice.
   const viewer_export::TileSetReader reader(tile_set_dir,
                                             full_resolution_bytes(tile_set_dir) <= kKeptWholeBytes
                                                 ? std::numeric_limits<std::size_t>::max()
