@@ -139,14 +139,99 @@ TEST(FeaturesFilters, FarSideOfAnOcclusionIsExcluded) {
   const std::vector<uint8_t> excluded = excluded_cells(scan, s);
   for (int c = 24; c <= 29; ++c) EXPECT_EQ(excluded[c], 1) << c;  // far side, left
   for (int c = 40; c <= 45; ++c) EXPECT_EQ(excluded[c], 1) << c;  // far side, right
-  for (int c = 30; c < 40; ++c) EXPECT_EQ(excluded[c], 0) << c;   // the pole itself
+  // The pole's cells within N of its ends count the wall in their curvature: none is a
+  // feature by its curvature (its ends are edges as occluding boundaries).
+  for (int c = 30; c < 40; ++c) EXPECT_EQ(excluded[c], 1) << c;
   EXPECT_EQ(excluded[15], 0);
   EXPECT_EQ(excluded[60], 0);
   // Range limits.
   FeatureSettings near = s;
   near.max_range_m = 8.0;
   EXPECT_EQ(excluded_cells(scan, near)[60], 1);
-  EXPECT_EQ(excluded_cells(scan, near)[35], 0);
+  EXPECT_EQ(excluded_cells(scan, near)[15], 1);
+}
+
+/// One row of columns 2 pi / 1024 apart (an OS1-128's), azimuth 0 at column 40: a face on the
+/// plane x = 5 m from y = face_from to y = face_to, a wall at x = 10 m behind it.
+Scan face_before_wall(float face_from, float face_to) {
+  const double step = 2.0 * M_PI / 1024.0;
+  return line_scan(1, 120, [&](int, int c) {
+    const double azimuth = step * (c - 40);
+    const Eigen::Vector3d direction(std::cos(azimuth), std::sin(azimuth), 0.0);
+    const double y_on_face = 5.0 * std::tan(azimuth);
+    const double x = (y_on_face >= face_from && y_on_face <= face_to) ? 5.0 : 10.0;
+    return Eigen::Vector3f((x / direction.x() * direction).cast<float>());
+  });
+}
+
+TEST(FeaturesFilters, OcclusionBoundariesAreTheNearCellsOfAFaceThatEnds) {
+  const FeatureSettings s = defaults();
+  const Scan scan = face_before_wall(0.2f, 0.8f);  // columns 47..65 on the face
+  const std::vector<int8_t> side = occluding_boundaries(scan, s);
+  for (int c = 0; c < scan.cols; ++c) {
+    const int expected = c == 47 ? -1 : (c == 65 ? 1 : 0);
+    EXPECT_EQ(side[static_cast<size_t>(c)], expected) << c;
+  }
+  // A face narrower than the N cells behind a boundary (a wire, a leaf) has none.
+  const std::vector<int8_t> thin = occluding_boundaries(face_before_wall(0.2f, 0.22f), s);
+  for (int8_t v : thin) EXPECT_EQ(v, 0);
+  // Nor one out of the range limits.
+  FeatureSettings near = s;
+  near.max_range_m = 4.0;
+  for (int8_t v : occluding_boundaries(scan, near)) EXPECT_EQ(v, 0);
+}
+
+TEST(FeaturesFilters, BoundaryPointFindsTheFacesEndWithoutBias) {
+  // The face's true end swept over one column's spacing: the near cell falls short of it by
+  // half a spacing on average, the boundary point by nothing.
+  const FeatureSettings s = defaults();
+  // Where the rays of columns 65 and 66 meet the face: about 3.1 cm apart.
+  const double step = 2.0 * M_PI / 1024.0;
+  const float last_ray = static_cast<float>(5.0 * std::tan(step * 25));
+  const float spacing = static_cast<float>(5.0 * std::tan(step * 26)) - last_ray;
+  double near_cell_mean = 0.0;
+  double boundary_mean = 0.0;
+  double boundary_worst = 0.0;
+  const int phases = 64;
+  for (int k = 0; k < phases; ++k) {
+    const float end = last_ray + spacing * (static_cast<float>(k) + 0.5f) / phases;
+    const Scan scan = face_before_wall(0.2f, end);
+    const std::vector<int8_t> side = occluding_boundaries(scan, s);
+    int at = -1;
+    for (int c = 0; c < scan.cols; ++c) {
+      if (side[static_cast<size_t>(c)] == 1) at = c;
+    }
+    ASSERT_EQ(at, 65) << k;
+    const Eigen::Vector3f p = boundary_point(scan, 0, at, 1, s.neighbours);
+    EXPECT_NEAR(p.x(), 5.0f, 1e-4f);  // on the face
+    near_cell_mean += (scan.xyz[static_cast<size_t>(at)].y() - end) / phases;
+    boundary_mean += (p.y() - end) / phases;
+    boundary_worst = std::max(boundary_worst, std::abs(static_cast<double>(p.y() - end)));
+  }
+  EXPECT_NEAR(near_cell_mean, -0.5 * spacing, 0.02 * spacing);
+  EXPECT_NEAR(boundary_mean, 0.0, 0.02 * spacing);
+  EXPECT_LE(boundary_worst, 0.51 * spacing);
+}
+
+TEST(FeaturesFilters, ExtractedEdgeOfAnOcclusionIsItsBoundaryPoint) {
+  FeatureSettings s = defaults();
+  s.intensity_fusion = false;
+  const Scan scan = face_before_wall(0.2f, 0.8f);
+  const FeatureSet set = extract_features(scan, s);
+  const Eigen::Vector3f left = boundary_point(scan, 0, 47, -1, s.neighbours);
+  const Eigen::Vector3f right = boundary_point(scan, 0, 65, 1, s.neighbours);
+  bool found_left = false;
+  bool found_right = false;
+  for (const Eigen::Vector3f& e : set.edges) {
+    found_left |= (e - left).norm() < 1e-5f;
+    found_right |= (e - right).norm() < 1e-5f;
+    // Nothing inside the face's ends, where the curvature measured the wall behind.
+    if (std::abs(e.x() - 5.0f) < 0.01f) {
+      EXPECT_TRUE((e - left).norm() < 1e-5f || (e - right).norm() < 1e-5f) << e.transpose();
+    }
+  }
+  EXPECT_TRUE(found_left);
+  EXPECT_TRUE(found_right);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <chrono>
+#include <cstdint>
 #include <optional>
 
 #include "featsense/slam/features/curvature.hpp"
@@ -68,6 +69,7 @@ FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
   // side by side (the curvature and the selection are parallel over rows themselves).
   std::optional<std::vector<uint8_t>> image_edges;
   std::vector<LinePicks> lines(static_cast<size_t>(scan.rows));
+  std::vector<int8_t> boundaries;
   tbb::parallel_invoke(
       [&] {
         const auto stage = Clock::now();
@@ -76,8 +78,18 @@ FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
       },
       [&] {
         auto stage = Clock::now();
-        const std::vector<float> curvature = curvature_image(scan, settings.neighbours);
-        const std::vector<uint8_t> excluded = excluded_cells(scan, settings);
+        std::vector<float> curvature = curvature_image(scan, settings.neighbours);
+        std::vector<uint8_t> excluded = excluded_cells(scan, settings);
+        boundaries = occluding_boundaries(scan, settings);
+        // An occluding boundary is an edge whatever its curvature says (which counts the far
+        // side's points): it competes with the others as a corner between the thresholds.
+        const float boundary_curvature =
+            static_cast<float>(0.5 * (settings.edge_threshold + settings.max_edge_threshold));
+        for (size_t i = 0; i < boundaries.size(); ++i) {
+          if (boundaries[i] == 0) continue;
+          curvature[i] = boundary_curvature;
+          excluded[i] = 0;
+        }
         local.curvature_ms = ms_since(stage);
         stage = Clock::now();
         tbb::parallel_for(0, scan.rows, [&](int row) {
@@ -99,7 +111,9 @@ FeatureSet extract_features(const Scan& scan, const FeatureSettings& settings,
         continue;
       }
       const size_t i = scan.index(row, col);
-      set.edges.push_back(scan.xyz[i]);
+      set.edges.push_back(boundaries[i] == 0
+                              ? scan.xyz[i]
+                              : boundary_point(scan, row, col, boundaries[i], settings.neighbours));
       set.edge_time_s.push_back(time_of(i));
     }
     for (int col : picks.surfaces) {
