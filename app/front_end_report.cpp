@@ -17,10 +17,13 @@ using bench::TimingSummary;
 
 std::string intensity_fusion_text(const slam::odometry::OdometryCounts& counts, bool enabled) {
   if (!enabled) return "off (odometry.intensity_fusion = false)";
-  if (counts.intensity_confirmed_scans == 0) return "off: the scans have no intensity channel";
+  if (counts.intensity_confirmed_scans == 0) {
+    return "off: the scans' intensity is missing or one value throughout";
+  }
   if (counts.intensity_confirmed_scans < counts.scans) {
     return "on for " + std::to_string(counts.intensity_confirmed_scans) + " of " +
-           std::to_string(counts.scans) + " scans (the others had no intensity channel)";
+           std::to_string(counts.scans) +
+           " scans (the others' intensity was missing or one value throughout)";
   }
   return "on";
 }
