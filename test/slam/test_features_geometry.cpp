@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include "featsense/config/config.hpp"
 #include "featsense/slam/features/curvature.hpp"
@@ -179,6 +180,14 @@ TEST(FeaturesFilters, OcclusionBoundariesAreTheNearCellsOfAFaceThatEnds) {
   FeatureSettings near = s;
   near.max_range_m = 4.0;
   for (int8_t v : occluding_boundaries(scan, near)) EXPECT_EQ(v, 0);
+  // A range that is not a number (a reader's bad cell marked valid) makes no jump: the face's
+  // end beside it is no boundary, nor is one whose face behind holds it.
+  Scan bad = scan;
+  bad.range_m[66] = std::numeric_limits<float>::quiet_NaN();
+  bad.range_m[50] = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<int8_t> with_nan = occluding_boundaries(bad, s);
+  EXPECT_EQ(with_nan[65], 0);
+  EXPECT_EQ(with_nan[47], 0);  // its N cells behind reach column 52
 }
 
 TEST(FeaturesFilters, BoundaryPointFindsTheFacesEndWithoutBias) {

@@ -78,7 +78,7 @@ std::vector<int8_t> occluding_boundaries(const Scan& scan, const FeatureSettings
       for (int k = 1; k <= n; ++k) {
         const int c = col - step * k;
         if (c < 0 || c >= scan.cols || !valid(c)) return false;
-        if (std::abs(range(c) - range(c + step)) > jump) return false;
+        if (!(std::abs(range(c) - range(c + step)) <= jump)) return false;  // NaN too
       }
       return (point(col) - point(col - step)).norm() <= parallel_gap * range(col);
     };
@@ -87,6 +87,7 @@ std::vector<int8_t> occluding_boundaries(const Scan& scan, const FeatureSettings
       const float a = range(col);
       const float b = range(col + 1);
       if (std::abs(a - b) <= jump) continue;
+      if (!std::isfinite(a) || !std::isfinite(b)) continue;  // no jump to judge
       const int near = a < b ? col : col + 1;
       const int step = a < b ? 1 : -1;  // from the near cell towards the far side
       if (range(near) < min_range || range(near) > max_range) continue;
