@@ -209,7 +209,7 @@ TEST(Config, ValueTextIsShort) {
   EXPECT_EQ(value_text(c, "sensor.min_range"), "null");
   EXPECT_EQ(value_text(c, "odometry.deskew"), "true");
   EXPECT_EQ(value_text(c, "odometry.optimization_steps"), "3");
-  EXPECT_EQ(value_text(c, "odometry.surface_voxel"), "0.4");
+  EXPECT_EQ(value_text(c, "odometry.surface_voxel"), "0.2");
   EXPECT_NE(error_of([] { value_text(Config{}, "map.voxelsize"); }).find("map.voxel_size"),
             std::string::npos);
 }

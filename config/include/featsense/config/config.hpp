@@ -97,7 +97,7 @@ struct OdometryConfig {
   bool hold_still = true;  ///< hold the pose while the sensor stands (see default.yaml)
   // Registration (slam/odometry). Why each value: default.yaml.
   double edge_voxel_m = 0.2;     ///< voxel of the local edge map and of each scan's edges
-  double surface_voxel_m = 0.4;  ///< voxel of the local surface map and of the scan's surfaces
+  double surface_voxel_m = 0.2;  ///< voxel of the local surface map and of the scan's surfaces
   double map_radius_m = 50.0;    ///< map points farther than this from the sensor are dropped
   double max_correspondence_distance_m = 1.0;  ///< the 5 neighbours lie within this
   double plane_tolerance_m = 0.05;             ///< see default.yaml
