@@ -112,7 +112,7 @@ struct OdometryConfig {
 struct RefineConfig {
   bool enabled = true;
   double distance_m = 5.0;
-  double voxel_m = 0.5;
+  double voxel_m = 0.3;
   int max_scans = 64;
   double min_constraint_ratio = 0.005;  ///< see default.yaml
 };
