@@ -21,11 +21,6 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-bool well_formed(const Scan& scan) {
-  return scan.rows > 0 && scan.cols > 0 && scan.xyz.size() == scan.size() &&
-         scan.range_m.size() == scan.size() && scan.valid.size() == scan.size();
-}
-
 }  // namespace
 
 FeatureSettings from_config(const config::Config& config) {

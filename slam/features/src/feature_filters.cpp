@@ -9,12 +9,6 @@ namespace featsense::slam::features {
 
 namespace {
 
-/// Every per-cell array of the scan has a cell for each of its rows * cols.
-bool well_formed(const Scan& scan) {
-  return scan.size() > 0 && scan.xyz.size() == scan.size() && scan.valid.size() == scan.size() &&
-         scan.range_m.size() == scan.size();
-}
-
 /// One scan line, by column.
 struct Line {
   const Scan& scan;
@@ -45,6 +39,11 @@ void for_each_jump(const Line& line, const FeatureSettings& settings, AtJump&& a
 }
 
 }  // namespace
+
+bool well_formed(const Scan& scan) {
+  return scan.rows > 0 && scan.cols > 0 && scan.xyz.size() == scan.size() &&
+         scan.range_m.size() == scan.size() && scan.valid.size() == scan.size();
+}
 
 std::vector<uint8_t> excluded_cells(const Scan& scan, const FeatureSettings& settings) {
   std::vector<uint8_t> excluded(scan.size(), 1);

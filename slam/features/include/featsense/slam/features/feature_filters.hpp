@@ -11,6 +11,10 @@
 
 namespace featsense::slam::features {
 
+/// Every per-cell array of the scan (points, ranges, valid flags) has a cell for each of its
+/// rows * cols, and it has some: the scans the filters and the extractor can read.
+bool well_formed(const Scan& scan);
+
 /// rows * cols, 1 where the cell may not become a feature: invalid, range outside
 /// [min_range_m, max_range_m], both line gaps above parallel_gap_ratio column spacings
 /// (range * 2 pi / cols), or within N cells of a range jump above occlusion_jump_m to the
