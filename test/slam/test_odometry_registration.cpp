@@ -425,9 +425,9 @@ TEST(OdometryStand, ACorridorsUnobservedAxisNeverStartsAStand) {
 
 TEST(OdometryStand, AWeaklyObservedAxisNeverStartsAStand) {
   // The corridor again, with an end wall 20 m ahead: the axis is observed (registered, not
-  // degenerate) but only by the few rows on that wall (J^T J / N about 0.01 along it). A
-  // sensor creeping along it at 8 cm/s moves within the noise bound of a stand; standing is
-  // claimed only where every direction is observed well, so it is not held.
+  // degenerate) but only by the few rows on that wall (J^T J / N about 0.02 along it, under
+  // the stand's 0.03). A sensor creeping along it at 8 cm/s moves within the noise bound of a
+  // stand; standing is claimed only where every direction is observed well, so it is not held.
   Scene hall = corridor();
   add_patch(hall.surfaces, {20, -1.5, 0}, {0, 3, 0}, {0, 0, 3}, 0.5);
   FeatureOdometry odometry(defaults());
