@@ -31,12 +31,12 @@ std::string csv_line(const mapping::LocalizedScan& scan) {
   }
   line += text;
   if (scan.registered) {
-    std::snprintf(text, sizeof text, "%.6f,%.4f,%.4f,%.6f,%.4f,", scan.fitness_m,
+    std::snprintf(text, sizeof text, "%.6f,%.4f,%.4f,%.6f,%.4f,%.6f,%.4f,", scan.fitness_m,
                   scan.inlier_fraction, scan.coverage, scan.position_sigma_m,
-                  scan.rotation_sigma_deg);
+                  scan.rotation_sigma_deg, scan.surface_position_m, scan.surface_rotation_deg);
     line += text;
   } else {
-    line += ",,,,,";
+    line += ",,,,,,,";
   }
   std::snprintf(text, sizeof text, "%.2f\n", scan.ms);
   return line + text;
@@ -51,7 +51,7 @@ LocalizationFiles::LocalizationFiles(const std::filesystem::path& folder)
       csv_(open_for_writing(csv_path_)) {
   tum_ << slam::kTumHeader << std::flush;
   csv_ << "stamp_s,status,x,y,z,qx,qy,qz,qw,fitness_m,inlier_fraction,coverage,position_sigma_m,"
-          "rotation_sigma_deg,ms\n"
+          "rotation_sigma_deg,surface_position_m,surface_rotation_deg,ms\n"
        << std::flush;
   if (!tum_) throw std::runtime_error("cannot write " + tum_path_.string());
   if (!csv_) throw std::runtime_error("cannot write " + csv_path_.string());

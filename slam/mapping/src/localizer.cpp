@@ -20,6 +20,7 @@
 #include "featsense/slam/trajectory/pose_interpolation.hpp"
 #include "featsense/slam/trajectory/sweep_motion.hpp"
 #include "keyframe_points.hpp"
+#include "map_path.hpp"
 #include "map_surface.hpp"
 #include "map_targets.hpp"
 #include "place_correlation.hpp"
@@ -89,6 +90,8 @@ constexpr size_t kMinPoints = 30;
 constexpr double kKeyframePointVoxel = 0.4;
 /// A surface is upright (a wall, a post) where its normal's vertical part is at most this.
 constexpr double kUprightMaxNormalZ = 0.5;
+/// The map's path, from where its surfaces were seen: one position kept per this distance.
+constexpr double kPathSpacing = 2.0;
 
 struct Localizer::State {
   State(const std::filesystem::path& map, const config::Config& config_in,
@@ -96,9 +99,10 @@ struct Localizer::State {
       : config(config_in),
         settings(localizer_from_config(config_in)),
         saved(read_saved_map(map)),
+        path(saved, kPathSpacing),
         surface(map, settings.cache_bytes, settings.vgicp.voxel_sizes_m.back(),
                 settings.vgicp.fitness_voxel_m, settings.min_weight),
-        targets(surface, settings.radius_m, settings.vgicp, settings.vgicp.fitness_voxel_m),
+        targets(surface, settings.radius_m, settings.vgicp, settings.vgicp.fitness_voxel_m, &path),
         initial_pose(initial) {
     relocalize = slam::loops::relocalize_from_config(config);
   }
@@ -108,7 +112,7 @@ struct Localizer::State {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   };
   /// The first of judge's tests a fit fails, in the order judge applies them.
-  enum class Shortfall { kNone, kObserved, kCoverage, kHeld, kInliers, kFitness };
+  enum class Shortfall { kNone, kObserved, kCoverage, kHeld, kSurface, kInliers, kFitness };
   struct Fit {
     slam::refine::VgicpResult result;
     MapFit map;
@@ -188,7 +192,7 @@ struct Localizer::State {
     std::shared_ptr<const MapTarget> target = build_map_target(
         surface, centre, settings.search_radius_m + cell_m, settings.search_voxel_sizes_m,
         settings.vgicp.fitness_voxel_m, settings.vgicp.fitness_voxel_m,
-        settings.search_reach_m > 0.0 ? kUprightMaxNormalZ : -1.0, beyond_surface());
+        settings.search_reach_m > 0.0 ? kUprightMaxNormalZ : -1.0, beyond_surface(), &path);
     search_targets.emplace_front(key, target);
     if (search_targets.size() > settings.search_targets_kept) search_targets.pop_back();
     return target;
@@ -274,8 +278,9 @@ struct Localizer::State {
 
   /// How `fit.result` fits the map, and whether that is a fit, a contradiction, or neither.
   void judge(const MapTarget& target, const slam::refine::GaussianCloud& cloud, Fit& fit) const {
-    fit.map = measure_map_fit(target, cloud, fit.result.T_target_source,
-                              settings.vgicp.inlier_distance_m);
+    fit.map =
+        measure_map_fit(target, cloud, fit.result.T_target_source, settings.vgicp.inlier_distance_m,
+                        settings.surface_angle_sigma_deg * M_PI / 180.0);
     // Where the map saw too little of what the scan sees, the fit says nothing either way.
     const bool telling = fit.map.observed >= settings.min_observed_points;
     const bool enough = telling && fit.map.coverage >= settings.min_coverage;
@@ -284,15 +289,19 @@ struct Localizer::State {
     // that ran out were trading voxels by millimetres.
     const bool held = fit.map.position_sigma_m <= settings.max_position_sigma_m &&
                       fit.map.rotation_sigma_deg <= settings.max_rotation_sigma_deg;
+    // Nor is one that rests on surfaces the map saw from afar: however many points hold it,
+    // it is where those surfaces are, and they may be centimetres off.
+    const bool surfaces_sure = fit.map.surface_position_m <= settings.max_surface_position_m;
     const bool inliers = fit.map.inlier_fraction >= settings.min_inlier_fraction;
     const bool close = fit.map.fitness_m <= settings.max_fitness_m;
-    fit.good = enough && held && inliers && close;
-    fit.shortfall = !telling   ? Shortfall::kObserved
-                    : !enough  ? Shortfall::kCoverage
-                    : !held    ? Shortfall::kHeld
-                    : !inliers ? Shortfall::kInliers
-                    : !close   ? Shortfall::kFitness
-                               : Shortfall::kNone;
+    fit.good = enough && held && surfaces_sure && inliers && close;
+    fit.shortfall = !telling         ? Shortfall::kObserved
+                    : !enough        ? Shortfall::kCoverage
+                    : !held          ? Shortfall::kHeld
+                    : !surfaces_sure ? Shortfall::kSurface
+                    : !inliers       ? Shortfall::kInliers
+                    : !close         ? Shortfall::kFitness
+                                     : Shortfall::kNone;
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
   }
 
@@ -312,6 +321,10 @@ struct Localizer::State {
       case Shortfall::kHeld:
         std::snprintf(text, sizeof text, "held to %.0f mm, %.2f deg only",
                       1000.0 * m.position_sigma_m, m.rotation_sigma_deg);
+        break;
+      case Shortfall::kSurface:
+        std::snprintf(text, sizeof text, "its surfaces, seen from afar, may move it %.0f mm",
+                      1000.0 * m.surface_position_m);
         break;
       case Shortfall::kInliers:
         std::snprintf(text, sizeof text, "%d %% of the scan on it",
@@ -356,6 +369,8 @@ struct Localizer::State {
     out.coverage = fit.map.coverage;
     out.position_sigma_m = fit.map.position_sigma_m;
     out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
+    out.surface_position_m = fit.map.surface_position_m;
+    out.surface_rotation_deg = fit.map.surface_rotation_deg;
     out.iterations = fit.result.iterations;
     // The keyframes that placed it fitted firmly (check_place); this scan confirms the place
     // as a tracked scan would.
@@ -497,6 +512,8 @@ struct Localizer::State {
     out.coverage = fit.map.coverage;
     out.position_sigma_m = fit.map.position_sigma_m;
     out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
+    out.surface_position_m = fit.map.surface_position_m;
+    out.surface_rotation_deg = fit.map.surface_rotation_deg;
     out.iterations = fit.result.iterations;
     if (fit.good) {
       const Eigen::Isometry3d T = fit.result.T_target_source;
@@ -527,9 +544,7 @@ struct Localizer::State {
       return lose(scan, "no fit to the map for longer than localize.odometry_timeout", predicted);
     }
     if (status == LocalizeStatus::kLocalized) {
-      out.event =
-          "on odometry: " + std::to_string(static_cast<int>(100.0 * fit.map.inlier_fraction)) +
-          " % of the scan on the map";
+      out.event = "on odometry: " + shortfall_text(fit);
     }
     status = LocalizeStatus::kOdometry;
     if (!odometry) {
@@ -548,6 +563,7 @@ struct Localizer::State {
   config::Config config;
   LocalizerSettings settings;
   SavedMap saved;
+  MapPath path;
   /// The map keyframes' points, for checking places where the surface has nothing: made at
   /// the first search.
   std::unique_ptr<const KeyframePoints> keyframe_points;

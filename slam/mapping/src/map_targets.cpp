@@ -14,12 +14,21 @@
 
 #include "background_thread.hpp"
 #include "featsense/slam/refine/gaussian_cloud.hpp"
+#include "map_path.hpp"
 
 namespace featsense::mapping {
 namespace {
 
 /// The neighbours whose spread is a keyframe point's covariance.
 constexpr int kKeyframeNeighbours = 10;
+/// A target's grid of where its places were seen from: cells this wide (a metre moves the
+/// range a surface was seen at by at most 0.7 m), from path positions up to this far beyond
+/// the target (a map's surface reaches half its local map's width from the path: 20 m by
+/// default).
+constexpr double kSeenFromCell = 1.0;
+constexpr double kSeenFromReach = 60.0;
+/// A surface no part of the path within that reach is near counts as seen from this far.
+constexpr double kUnseenRange = 100.0;
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -29,8 +38,11 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
-                       const Eigen::Isometry3d& T, double inlier_distance_m) {
+                       const Eigen::Isometry3d& T, double inlier_distance_m,
+                       double surface_angle_sigma_rad) {
   MapFit fit;
+  // Each inlier's row and its surface's own sigma, for the map's share of the error.
+  std::vector<std::pair<Eigen::Matrix<double, 6, 1>, double>> rows;
   fit.points = cloud.size();
   double squares = 0.0;
   // Each inlier's distance to its plane, as a function of a small motion of the sensor
@@ -52,6 +64,14 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
     Eigen::Matrix<double, 6, 1> row;
     row << (q - sensor).cross(n), n;
     information.selfadjointView<Eigen::Upper>().rankUpdate(row);
+    if (target.seen_from && surface_angle_sigma_rad > 0.0) {
+      const Eigen::Vector3f* from = target.seen_from->nearest(found.front()->mean);
+      const double sigma =
+          from != nullptr
+              ? surface_sigma(found.front()->mean, n, from->cast<double>(), surface_angle_sigma_rad)
+              : surface_angle_sigma_rad * kUnseenRange;
+      rows.emplace_back(row, sigma);
+    }
   }
   if (fit.observed > 0)
     fit.inlier_fraction = static_cast<double>(fit.inliers) / static_cast<double>(fit.observed);
@@ -63,7 +83,8 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
     // The pose's covariance (fitness_m^2 per measurement); its largest spread per block.
     Eigen::FullPivLU<Eigen::Matrix<double, 6, 6>> lu(full);
     if (lu.isInvertible()) {
-      const Eigen::Matrix<double, 6, 6> covariance = lu.inverse() * fit.fitness_m * fit.fitness_m;
+      const Eigen::Matrix<double, 6, 6> inverse = lu.inverse();
+      const Eigen::Matrix<double, 6, 6> covariance = inverse * fit.fitness_m * fit.fitness_m;
       const auto largest = [](const Eigen::Matrix3d& block) {
         return std::sqrt(std::max(
             0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block, Eigen::EigenvaluesOnly)
@@ -72,14 +93,23 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
       };
       fit.rotation_sigma_deg = largest(covariance.topLeftCorner<3, 3>()) * 180.0 / M_PI;
       fit.position_sigma_m = largest(covariance.bottomRightCorner<3, 3>());
+      // The pose moves by inverse(information) * row * e for an error e of one surface along
+      // its normal. A surface's error is shared by every point on it (it does not average out
+      // as the points' spread does): each taken at its sigma with the sign that moves each
+      // component most.
+      Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
+      for (const auto& [row, sigma] : rows) shift += (inverse * row).cwiseAbs() * sigma;
+      fit.surface_rotation_deg = shift.head<3>().norm() * 180.0 / M_PI;
+      fit.surface_position_m = shift.tail<3>().norm();
     }
   }
   return fit;
 }
 
 MapTargets::MapTargets(MapSurface& surface, double radius_m,
-                       const slam::refine::VgicpSettings& vgicp, double block_m)
-    : surface_(surface), radius_m_(radius_m), vgicp_(vgicp), block_m_(block_m) {
+                       const slam::refine::VgicpSettings& vgicp, double block_m,
+                       const MapPath* path)
+    : surface_(surface), radius_m_(radius_m), vgicp_(vgicp), block_m_(block_m), path_(path) {
   if (vgicp_.voxel_sizes_m.empty())
     throw std::invalid_argument("MapTargets: the registration needs at least one voxel size");
   thread_ = std::thread([this] { run(); });
@@ -94,12 +124,10 @@ MapTargets::~MapTargets() {
   thread_.join();
 }
 
-std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
-                                                  const Eigen::Vector3d& centre, double radius_m,
-                                                  const std::vector<double>& voxel_sizes_m,
-                                                  double fitness_voxel_m, double block_m,
-                                                  double upright_max_normal_z,
-                                                  const KeyframePoints* beyond) {
+std::shared_ptr<const MapTarget> build_map_target(
+    MapSurface& surface, const Eigen::Vector3d& centre, double radius_m,
+    const std::vector<double>& voxel_sizes_m, double fitness_voxel_m, double block_m,
+    double upright_max_normal_z, const KeyframePoints* beyond, const MapPath* path) {
   const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m);
   const std::vector<std::shared_ptr<const ChunkSurface>> surfaces =
       surface.surfaces_in(Eigen::AlignedBox3d(centre - reach, centre + reach));
@@ -149,6 +177,8 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
       centre, slam::refine::VgicpTarget(std::move(levels), std::move(fitness)));
   made->observed = std::move(observed);
   made->block_m = block_m;
+  if (path != nullptr)
+    made->seen_from.emplace(*path, centre, radius_m, kSeenFromCell, kSeenFromReach);
   if (with_upright) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
     for (const slam::refine::VoxelGaussian& part : parts) {
@@ -163,8 +193,9 @@ std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
 
 std::shared_ptr<const MapTarget> MapTargets::build(const Eigen::Vector3d& centre) {
   const auto start = std::chrono::steady_clock::now();
-  std::shared_ptr<const MapTarget> target = build_map_target(
-      surface_, centre, radius_m_, vgicp_.voxel_sizes_m, vgicp_.fitness_voxel_m, block_m_);
+  std::shared_ptr<const MapTarget> target =
+      build_map_target(surface_, centre, radius_m_, vgicp_.voxel_sizes_m, vgicp_.fitness_voxel_m,
+                       block_m_, -1.0, nullptr, path_);
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.built;
   counts_.build_ms += ms_since(start);

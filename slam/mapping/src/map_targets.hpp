@@ -21,6 +21,7 @@
 
 #include "featsense/slam/refine/vgicp.hpp"
 #include "keyframe_points.hpp"
+#include "map_path.hpp"
 #include "map_surface.hpp"
 
 namespace featsense::mapping {
@@ -38,6 +39,9 @@ struct MapTarget {
   std::vector<Eigen::Vector2f> upright;
   /// ... and of the columns of observed blocks (once each), where upright cells were asked for.
   std::vector<Eigen::Vector2f> observed_columns;
+  /// Where the map's path passed nearest to each place of the target, where the map has a
+  /// path: from how far its surfaces were seen.
+  std::optional<SeenFrom> seen_from;
 };
 
 /// How a scan placed at a pose fits the map: of its points where the map observed anything,
@@ -58,9 +62,17 @@ struct MapFit {
   /// street's facades seen alone fix nothing along the street).
   double position_sigma_m = std::numeric_limits<double>::infinity();
   double rotation_sigma_deg = std::numeric_limits<double>::infinity();
+  /// How far the map's own surfaces may have moved the pose: each inlier's surface known to
+  /// `surface_angle_sigma_rad` times how obliquely and from how far the map saw it
+  /// (surface_sigma), and the error of a surface shared by all its points. Where the sensor
+  /// stands on ground the map saw only from 30 m, this is what its height is worth, however
+  /// many points hold it. 0 where the target has no path.
+  double surface_position_m = 0.0;
+  double surface_rotation_deg = 0.0;
 };
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
-                       const Eigen::Isometry3d& T, double inlier_distance_m);
+                       const Eigen::Isometry3d& T, double inlier_distance_m,
+                       double surface_angle_sigma_rad = 0.0);
 
 /// The target of the surface within `radius_m` (horizontally) of `centre`, with voxels of
 /// `voxel_sizes_m` (multiples of the surface's cells) and the fit's voxels of `fitness_voxel_m`,
@@ -70,12 +82,14 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
 /// (each with its neighbours' covariance) and their blocks count as observed: a target for
 /// checking a place found from scratch, not for tracking (they are less accurate than the
 /// surface: a keyframe's heading error times the range they were seen at).
+/// Where `path` is given, the target knows from where its surfaces were seen (seen_from).
 std::shared_ptr<const MapTarget> build_map_target(MapSurface& surface,
                                                   const Eigen::Vector3d& centre, double radius_m,
                                                   const std::vector<double>& voxel_sizes_m,
                                                   double fitness_voxel_m, double block_m,
                                                   double upright_max_normal_z = -1.0,
-                                                  const KeyframePoints* beyond = nullptr);
+                                                  const KeyframePoints* beyond = nullptr,
+                                                  const MapPath* path = nullptr);
 
 struct MapTargetCounts {
   size_t built = 0;
@@ -89,7 +103,7 @@ class MapTargets {
   /// Targets of `radius_m` around the sensor with the voxels of `vgicp` (its voxel sizes must
   /// be multiples of the surface's cells, the finest the cell itself).
   MapTargets(MapSurface& surface, double radius_m, const slam::refine::VgicpSettings& vgicp,
-             double block_m);
+             double block_m, const MapPath* path = nullptr);
   ~MapTargets();
   MapTargets(const MapTargets&) = delete;
   MapTargets& operator=(const MapTargets&) = delete;
@@ -109,6 +123,7 @@ class MapTargets {
   double radius_m_;
   slam::refine::VgicpSettings vgicp_;
   double block_m_;
+  const MapPath* path_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
