@@ -1,8 +1,10 @@
 #pragma once
 /// The local feature map around the sensor: edge and surface points in the map frame, one
 /// per voxel (odometry.edge_voxel / surface_voxel), those farther than odometry.map_radius
-/// from the sensor dropped. Each scan adds its features and prunes the map, and the two k-d
-/// trees (nanoflann) are then rebuilt: once per registered scan, as F-LOAM.
+/// from the sensor dropped. Each scan adds its features and prunes the map once registered.
+/// The points are searched in nanoflann's logarithmic k-d trees (static trees of 1, 2, 4 ...
+/// points): a scan's new points are merged in and the dropped ones marked removed, so that a
+/// scan costs what it changed rather than a tree over the whole map, as F-LOAM rebuilds.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -20,8 +22,7 @@ class LocalFeatureMap {
   LocalFeatureMap& operator=(const LocalFeatureMap&) = delete;
 
   /// Adds a scan's features (sensor frame) at `T_map_sensor` (a point goes in where its voxel
-  /// is still free), drops what lies farther than the radius from the sensor and rebuilds
-  /// the k-d trees.
+  /// is still free) and drops what lies farther than the radius from the sensor.
   void add(const std::vector<Eigen::Vector3f>& edges, const std::vector<Eigen::Vector3f>& surfaces,
            const Eigen::Isometry3d& T_map_sensor);
 
