@@ -9,9 +9,11 @@
 ///    until it passes, no pose is given.
 ///  - localized: the scan registered to the map's surface around the predicted pose
 ///    (voxelized GICP, the surface of the TSDF as the target: map_targets) and it fits: enough
-///    of its points lie on the map's surface, closely enough. The prediction is constant
-///    velocity from the last two poses, turned as the gyroscope measured where the scans carry
-///    IMU samples (and deskews the scan), or the odometry's motion while that still runs.
+///    of its points lie on the map's surface, closely enough, they hold the pose firmly, and
+///    the surfaces they lie on were seen from near enough to be sure of (map_path). The
+///    prediction is constant velocity from the last two poses, turned as the gyroscope
+///    measured where the scans carry IMU samples (and deskews the scan), or the odometry's
+///    motion while that still runs.
 ///  - odometry: the scan did not fit well enough (changed surroundings, a place the map never
 ///    saw, a view blocked): the odometry, started at the last pose, carries the pose on and
 ///    the registration is tried again from it each scan. Too long on odometry, or several
