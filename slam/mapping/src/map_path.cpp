@@ -44,10 +44,8 @@ SeenFrom::SeenFrom(const MapPath& path, const Eigen::Vector3d& centre, double ra
   std::vector<Eigen::Vector3d> near;
   for (const Eigen::Vector3d& p : path.positions())
     if ((p - centre).head<2>().cwiseAbs().maxCoeff() <= within) near.push_back(p);
-  nearest_.assign(static_cast<size_t>(cells_) * static_cast<size_t>(cells_),
-                  Eigen::Vector3f::Zero());
-  found_.assign(nearest_.size(), false);
-  if (near.empty()) return;
+  if (near.empty()) return;  // no grid: nowhere near the path
+  nearest_.resize(static_cast<size_t>(cells_) * static_cast<size_t>(cells_));
   for (int j = 0; j < cells_; ++j) {
     for (int i = 0; i < cells_; ++i) {
       const Eigen::Vector2d c = origin_ + cell_m_ * Eigen::Vector2d(i + 0.5, j + 0.5);
@@ -62,7 +60,6 @@ SeenFrom::SeenFrom(const MapPath& path, const Eigen::Vector3d& centre, double ra
       }
       const size_t at = static_cast<size_t>(j) * static_cast<size_t>(cells_) + i;
       nearest_[at] = nearest->cast<float>();
-      found_[at] = true;
     }
   }
 }
@@ -71,9 +68,8 @@ const Eigen::Vector3f* SeenFrom::nearest(const Eigen::Vector3d& p) const {
   const Eigen::Vector2d at = (p.head<2>() - origin_) / cell_m_;
   const int i = static_cast<int>(std::floor(at.x()));
   const int j = static_cast<int>(std::floor(at.y()));
-  if (i < 0 || j < 0 || i >= cells_ || j >= cells_) return nullptr;
-  const size_t k = static_cast<size_t>(j) * static_cast<size_t>(cells_) + i;
-  return found_[k] ? &nearest_[k] : nullptr;
+  if (nearest_.empty() || i < 0 || j < 0 || i >= cells_ || j >= cells_) return nullptr;
+  return &nearest_[static_cast<size_t>(j) * static_cast<size_t>(cells_) + i];
 }
 
 double surface_sigma(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,

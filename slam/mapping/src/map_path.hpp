@@ -45,8 +45,8 @@ class SeenFrom {
   Eigen::Vector2d origin_;
   double cell_m_;
   int cells_ = 0;  ///< along each side
+  /// Per cell, row by row; empty where no path position lies within the reach.
   std::vector<Eigen::Vector3f> nearest_;
-  std::vector<bool> found_;
 };
 
 /// The standard deviation along `normal` of a surface at `point` seen from `seen_from`, where
