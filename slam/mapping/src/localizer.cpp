@@ -305,6 +305,18 @@ struct Localizer::State {
     fit.contradicts = telling && fit.map.inlier_fraction < settings.contradiction_fraction;
   }
 
+  /// The fit's figures in a scan's answer.
+  static void describe_fit(const Fit& fit, LocalizedScan& out) {
+    out.fitness_m = fit.map.fitness_m;
+    out.inlier_fraction = fit.map.inlier_fraction;
+    out.coverage = fit.map.coverage;
+    out.position_sigma_m = fit.map.position_sigma_m;
+    out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
+    out.surface_position_m = fit.map.surface_position_m;
+    out.surface_rotation_deg = fit.map.surface_rotation_deg;
+    out.iterations = fit.result.iterations;
+  }
+
   /// What keeps `fit` from being good (judge's first failed test), in words.
   static std::string shortfall_text(const Fit& fit) {
     char text[96];
@@ -364,14 +376,7 @@ struct Localizer::State {
     if (cloud.size() >= kMinPoints)
       fit = fit_on(*targets.around(guess.translation()), cloud, guess, false);
     out.registered = true;
-    out.fitness_m = fit.map.fitness_m;
-    out.inlier_fraction = fit.map.inlier_fraction;
-    out.coverage = fit.map.coverage;
-    out.position_sigma_m = fit.map.position_sigma_m;
-    out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
-    out.surface_position_m = fit.map.surface_position_m;
-    out.surface_rotation_deg = fit.map.surface_rotation_deg;
-    out.iterations = fit.result.iterations;
+    describe_fit(fit, out);
     // The keyframes that placed it fitted firmly (check_place); this scan confirms the place
     // as a tracked scan would.
     if (!fit.good) {
@@ -507,14 +512,7 @@ struct Localizer::State {
     counts.register_ms.push_back(ms_since(register_start));
     LocalizedScan out;
     out.registered = fit.points > 0;
-    out.fitness_m = fit.map.fitness_m;
-    out.inlier_fraction = fit.map.inlier_fraction;
-    out.coverage = fit.map.coverage;
-    out.position_sigma_m = fit.map.position_sigma_m;
-    out.rotation_sigma_deg = fit.map.rotation_sigma_deg;
-    out.surface_position_m = fit.map.surface_position_m;
-    out.surface_rotation_deg = fit.map.surface_rotation_deg;
-    out.iterations = fit.result.iterations;
+    describe_fit(fit, out);
     if (fit.good) {
       const Eigen::Isometry3d T = fit.result.T_target_source;
       if (status == LocalizeStatus::kOdometry) out.event = "localized again";
