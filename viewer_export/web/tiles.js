@@ -13,14 +13,6 @@ window.featsenseTiles = state;
 
 const container = document.getElementById('scene');
 const status = document.getElementById('status');
-// No multisampling: on a software rasterizer (a machine without a GPU) it is a large share of
-// every frame's work; the page's other viewer does without it too.
-const renderer = new THREE.WebGLRenderer({ antialias: false });
-renderer.setPixelRatio(window.devicePixelRatio);
-renderer.setSize(window.innerWidth, window.innerHeight);
-renderer.setClearColor(0x20242a);
-container.appendChild(renderer.domElement);
-
 const scene = new THREE.Scene();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.4);
@@ -28,15 +20,16 @@ sun.position.set(0.4, 1.0, 0.6);
 scene.add(sun);
 
 const camera = new THREE.PerspectiveCamera(55, window.innerWidth / window.innerHeight, 0.1, 1e5);
-const controls = new OrbitControls(camera, renderer.domElement);
-controls.screenSpacePanning = true;
+// Made with the renderer, once the first tiles are on their way.
+let controls = null;
+const viewTarget = new THREE.Vector3();
 
 const tiles = new TilesRenderer('tileset/tileset.json');
 // The tileset is the map frame, Z up; three.js is Y up.
 tiles.group.rotation.x = -Math.PI / 2;
 scene.add(tiles.group);
 tiles.setCamera(camera);
-tiles.setResolutionFromRenderer(camera, renderer);
+tiles.setResolution(camera, window.innerWidth, window.innerHeight);
 
 const errorTarget = document.getElementById('error-target');
 tiles.errorTarget = Number(errorTarget.value);
@@ -86,18 +79,25 @@ tiles.addEventListener('load-tileset', () => {
   const focus = (parameter('focus') || '').split(',').map(Number);
   const distance = Number(parameter('distance'));
   if (focus.length === 3 && focus.every(Number.isFinite) && distance > 0) {
-    const target = toView(focus[0], focus[1], focus[2]);
-    controls.target.copy(target);
-    camera.position.copy(target).add(new THREE.Vector3(0, 0.8, 0.6).normalize().multiplyScalar(distance));
+    viewTarget.copy(toView(focus[0], focus[1], focus[2]));
+    camera.position.copy(viewTarget).add(new THREE.Vector3(0, 0.8, 0.6).normalize().multiplyScalar(distance));
   } else {
     const centre = box.getCenter(new THREE.Vector3());
     const size = box.getSize(new THREE.Vector3()).length();
-    controls.target.copy(centre);
+    viewTarget.copy(centre);
     camera.position.copy(centre).add(new THREE.Vector3(0, 0.7, 0.7).multiplyScalar(size));
   }
   camera.far = Math.max(1e4, box.getSize(new THREE.Vector3()).length() * 10);
   camera.updateProjectionMatrix();
-  controls.update();
+  camera.lookAt(viewTarget);
+  if (controls) {
+    controls.target.copy(viewTarget);
+    controls.update();
+  }
+  // The tiles the view needs are asked for now, not at the next frame.
+  camera.updateMatrixWorld();
+  tiles.update();
+  Scheduler.flushPending();
 });
 
 tiles.addEventListener('load-model', ({ scene: model }) => {
@@ -126,6 +126,39 @@ tiles.addEventListener('load-error', ({ url, error }) => {
   status.textContent = 'A tile could not be loaded: ' + url;
 });
 
+function shownText() {
+  const levels = Object.keys(state.visible).map(Number).filter((l) => l >= 0).sort((a, b) => a - b);
+  return levels.map((l) => (l === 0 ? 'full resolution' : 'level ' + l) + ': ' +
+    state.visible[l].length).join(', ');
+}
+
+// The tile set and the tiles the view needs are asked for before the WebGL context is made:
+// making it holds the page's thread 0.4-1.9 s in a browser just started on a machine without
+// a GPU (a software rasterizer), and the downloads run meanwhile. Not longer than a second: a
+// slow tile set is waited for with the page drawn.
+const tilesetLoaded = new Promise((resolve) => {
+  tiles.addEventListener('load-tileset', resolve);
+  tiles.addEventListener('load-error', resolve);
+  setTimeout(resolve, 1000);
+});
+camera.updateMatrixWorld();
+tiles.update();
+Scheduler.flushPending();
+await tilesetLoaded;
+
+// No multisampling: on a software rasterizer (a machine without a GPU) it is a large share of
+// every frame's work; the page's other viewer does without it too.
+const renderer = new THREE.WebGLRenderer({ antialias: false });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(0x20242a);
+container.appendChild(renderer.domElement);
+
+controls = new OrbitControls(camera, renderer.domElement);
+controls.screenSpacePanning = true;
+controls.target.copy(viewTarget);
+controls.update();
+
 window.addEventListener('resize', () => {
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
@@ -133,12 +166,6 @@ window.addEventListener('resize', () => {
   renderer.setSize(window.innerWidth, window.innerHeight);
   tiles.setResolutionFromRenderer(camera, renderer);
 });
-
-function shownText() {
-  const levels = Object.keys(state.visible).map(Number).filter((l) => l >= 0).sort((a, b) => a - b);
-  return levels.map((l) => (l === 0 ? 'full resolution' : 'level ' + l) + ': ' +
-    state.visible[l].length).join(', ');
-}
 
 function frame() {
   requestAnimationFrame(frame);
