@@ -207,7 +207,7 @@ Command register_localize(CLI::App& app, const CliContext& context) {
       ->required();
   command->add_option("--initial-pose", options->initial_pose,
                       "x,y,z,yaw_deg: where the first scan is believed to be in the map; "
-                      "verified like any other match");
+                      "narrows the first search to places within 10 m and 30 degrees of it");
   command
       ->add_option("--gt", options->gt,
                    "True poses in the map's frame (TUM or KITTI): each pose's error goes "

@@ -106,6 +106,61 @@ TEST(Relocalizer, AGuessOutsideTheMapPlacesNothing) {
   EXPECT_LT((placed->T_map_session.translation() - truth.front().translation()).norm(), 0.1);
 }
 
+TEST(Relocalizer, AGuessThatNarrowsTheSearchTakesNoPlaceFarFromIt) {
+  // A place elsewhere that looks alike: a verifier that, from any candidate, finds the
+  // recording 30 m along the lane from where it is (the true place is not in the map, the
+  // look-alike is). A guess that only adds its places lets the look-alike place the recording;
+  // one that narrows the search does not, and places it where the verifier finds the truth,
+  // but not turned the other way.
+  const mesh::TriangleMesh scene = build_scene("parking");
+  const std::vector<Eigen::Isometry3d> truth = eastbound(10.0, 24.0);
+  size_t k = 0;
+  double found_along_m = 30.0;
+  bool turned = false;
+  const PlaceVerifier look_alike = [&](const Eigen::Isometry3d&, const refine::GaussianCloud&) {
+    PlaceCheck check;
+    Eigen::Isometry3d found = pose(0.0, 0.0, 0.0, {found_along_m, 0.0, 0.0}) * truth[k];
+    if (turned) found.linear() = found.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ());
+    check.T_map_query = found;
+    check.inlier_fraction = 0.8;
+    return check;
+  };
+  const auto run = [&](bool guess_only, double guess_off_m) {
+    RelocalizeSettings settings;
+    // The session's frame is its first pose: the guess of T_map_session is that pose.
+    settings.guess = pose(0.0, 0.0, 0.0, {guess_off_m, 0.0, 0.0}) * truth.front();
+    settings.guess_only = guess_only;
+    Relocalizer relocalizer(lane_map(scene, 0, eastbound(6.0, 58.0)), settings, look_alike);
+    std::optional<Relocalization> placed;
+    for (k = 0; k < truth.size() && !placed; ++k) {
+      placed = relocalizer.add_keyframe(
+          static_cast<int64_t>(k) * 400'000'000, truth.front().inverse() * truth[k], 2.0 * k,
+          test::keyframe_scan_at(scene, truth[k], static_cast<uint32_t>(k)));
+    }
+    return std::make_pair(placed, relocalizer.counts());
+  };
+  const auto [added, added_counts] = run(false, 0.0);
+  ASSERT_TRUE(added);
+  EXPECT_NEAR(added->T_map_session.translation().x() - truth.front().translation().x(), 30.0, 1e-9);
+
+  const auto [narrowed, narrowed_counts] = run(true, 0.0);
+  EXPECT_FALSE(narrowed);
+  EXPECT_EQ(narrowed_counts.verified, 0u);
+  EXPECT_EQ(narrowed_counts.rejected.at("away from the guess"), narrowed_counts.candidates);
+
+  // Where the verifier finds the truth, a guess 3 m off it narrows the search to it.
+  found_along_m = 0.0;
+  const auto [found, found_counts] = run(true, 3.0);
+  ASSERT_TRUE(found);
+  EXPECT_LT((found->T_map_session.translation() - truth.front().translation()).norm(), 1e-9);
+
+  // ... and where it finds the same street seen the other way, that is no match either.
+  turned = true;
+  const auto [reversed, reversed_counts] = run(true, 0.0);
+  EXPECT_FALSE(reversed);
+  EXPECT_EQ(reversed_counts.verified, 0u);
+}
+
 TEST(Relocalizer, AVerifierChecksTheCandidatesInPlaceOfTheMapKeyframes) {
   // A verifier (a localizer's registration to the map's surface) decides each candidate: here
   // one that knows the truth, takes a guess within 6 m of it and gives the true place.

@@ -208,9 +208,22 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
     double support() const { return result.inlier_fraction * coverage; }
   };
   std::vector<Verified> verified;
+  // Where the guess narrows the search, a place farther from it or turned from it is not
+  // tried, nor one that the registration moved there.
+  const auto away_from_guess = [&](const Candidate& candidate, const Eigen::Isometry3d& at) {
+    if (!settings_.guess || !(settings_.guess_only || candidate.found_by == "guess")) return false;
+    const Eigen::Isometry3d believed = *settings_.guess * T_session_sensor;
+    if ((at.translation() - believed.translation()).norm() > settings_.guess_radius_m) return true;
+    return settings_.guess_only && rotation_angle_deg(believed.rotation().transpose() *
+                                                      at.rotation()) > settings_.guess_angle_deg;
+  };
   const auto verify = [&](const std::vector<Candidate>& list) {
     counts_.candidates += list.size();
     for (const Candidate& candidate : list) {
+      if (away_from_guess(candidate, map_poses_[candidate.map_keyframe] * candidate.guess)) {
+        reject("away from the guess");
+        continue;
+      }
       refine::VgicpResult result;
       std::optional<Eigen::Isometry3d> placed;
       double coverage = 1.0;
@@ -239,9 +252,7 @@ std::optional<Relocalization> Relocalizer::add_keyframe(
       }
       if (!placed) continue;
       const Eigen::Isometry3d T_map_query = *placed;
-      if (candidate.found_by == "guess" &&
-          (T_map_query.translation() - (*settings_.guess * T_session_sensor).translation()).norm() >
-              settings_.guess_radius_m) {
+      if (away_from_guess(candidate, T_map_query)) {
         reject("away from the guess");
         continue;
       }

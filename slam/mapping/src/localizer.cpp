@@ -123,8 +123,10 @@ struct Localizer::State {
   };
 
   /// The search from scratch: the odometry from `T_first` (the belief, or the identity) and a
-  /// relocalizer that tries the map keyframes around the belief too where there is one.
-  void start_search(const std::optional<Eigen::Isometry3d>& belief) {
+  /// relocalizer that tries the map keyframes around the belief too where there is one, and
+  /// those alone where `belief_narrows` (the user's initial pose: a place elsewhere that looks
+  /// alike is no match; a belief of the tracking's, after a loss, may be far off).
+  void start_search(const std::optional<Eigen::Isometry3d>& belief, bool belief_narrows) {
     odometry = slam::odometry::make_odometry_locator(
         config, belief.value_or(Eigen::Isometry3d::Identity()));
     T_map_odometry = Eigen::Isometry3d::Identity();
@@ -133,6 +135,7 @@ struct Localizer::State {
     search_settings.ring_candidates = settings.search_ring_candidates;
     search_settings.verifications = settings.search_verifications;
     if (belief) search_settings.guess = Eigen::Isometry3d::Identity();
+    search_settings.guess_only = belief && belief_narrows;
     new_relocalizer();
     selector = std::make_unique<slam::loops::KeyframeSelector>(
         search_settings.loop.keyframe_distance_m, search_settings.loop.keyframe_angle_deg);
@@ -357,7 +360,7 @@ struct Localizer::State {
 
   LocalizedScan search(const slam::Scan& scan) {
     LocalizedScan out;
-    if (!odometry) start_search(initial_pose);
+    if (!odometry) start_search(initial_pose, true);
     std::string why;
     const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
     if (!placed || !selector->next(placed->T_map_sensor)) return out;
@@ -430,7 +433,7 @@ struct Localizer::State {
     out.event = "lost: " + reason;
     status = LocalizeStatus::kLost;
     on_odometry_since.reset();
-    start_search(belief);
+    start_search(belief, false);
     // The scan that lost it is the first of the search.
     std::string why;
     const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);

@@ -227,10 +227,11 @@ struct LocalizerCounts {
 class Localizer {
  public:
   /// Opens `map` (a featsense map.h5) read-only and reads its keyframes. `initial_pose` (the
-  /// first scan's pose in the map, a user's guess) narrows the first search; it is verified
-  /// like every match. Throws std::runtime_error naming the file and the problem (missing,
-  /// corrupt, no keyframes), config::ConfigError where the configuration sets another voxel
-  /// size than the map's.
+  /// first scan's pose in the map, a user's guess) narrows the first search to places within
+  /// 10 m and 30 degrees of it, as the odometry carries it; each is verified like every match.
+  /// Throws std::runtime_error naming the file and the problem (missing, corrupt, no
+  /// keyframes), config::ConfigError where the configuration sets another voxel size than the
+  /// map's.
   Localizer(const std::filesystem::path& map, const config::Config& config,
             const std::optional<Eigen::Isometry3d>& initial_pose = std::nullopt);
   ~Localizer();

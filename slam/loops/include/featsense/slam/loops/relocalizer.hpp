@@ -49,6 +49,13 @@ struct RelocalizeSettings {
   std::optional<Eigen::Isometry3d> guess;
   double guess_radius_m = 10.0;
   size_t guess_candidates = 3;
+  /// Whether the guess narrows the search (every place, however proposed, within
+  /// guess_radius_m of it and turned at most guess_angle_deg from it) rather than adding its
+  /// places to the rest: where the user knows roughly where the sensor is and which way it
+  /// faces, a place elsewhere that looks alike is no match, nor the same street seen the other
+  /// way.
+  bool guess_only = false;
+  double guess_angle_deg = 30.0;
 };
 
 /// loop.* and relocalize.confirmations of `config`; the rest as RelocalizeSettings{} has it.
