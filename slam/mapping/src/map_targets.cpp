@@ -49,27 +49,25 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
   // (rotation about the sensor, then translation): its row of the point-to-plane problem.
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   const Eigen::Vector3d sensor = T.translation();
-  std::vector<const slam::refine::VoxelGaussian*> found;
   for (const Eigen::Vector3d& p : cloud.points) {
     const Eigen::Vector3d q = T * p;
     if (target.observed.count(grid_key(grid_index(q, target.block_m))) == 0) continue;
     ++fit.observed;
-    target.vgicp.fitness.near(q, found);
-    if (found.empty()) continue;
-    const double d = found.front()->normal.dot(q - found.front()->mean);
+    const slam::refine::VoxelGaussian* voxel = target.vgicp.fitness.at(q);
+    if (voxel == nullptr) continue;
+    const double d = voxel->normal.dot(q - voxel->mean);
     if (std::abs(d) > inlier_distance_m) continue;
     ++fit.inliers;
     squares += d * d;
-    const Eigen::Vector3d& n = found.front()->normal;
+    const Eigen::Vector3d& n = voxel->normal;
     Eigen::Matrix<double, 6, 1> row;
     row << (q - sensor).cross(n), n;
     information.selfadjointView<Eigen::Upper>().rankUpdate(row);
     if (target.seen_from && surface_angle_sigma_rad > 0.0) {
-      const Eigen::Vector3f* from = target.seen_from->nearest(found.front()->mean);
-      const double sigma =
-          from != nullptr
-              ? surface_sigma(found.front()->mean, n, from->cast<double>(), surface_angle_sigma_rad)
-              : surface_angle_sigma_rad * kUnseenRange;
+      const Eigen::Vector3f* from = target.seen_from->nearest(voxel->mean);
+      const double sigma = from != nullptr ? surface_sigma(voxel->mean, n, from->cast<double>(),
+                                                           surface_angle_sigma_rad)
+                                           : surface_angle_sigma_rad * kUnseenRange;
       rows.emplace_back(row, sigma);
     }
   }

@@ -56,13 +56,11 @@ VgicpFit measure_fit(const VoxelGaussians& target, const GaussianCloud& source,
   const Sum sum = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, source.size(), 512), Sum{},
       [&](const tbb::blocked_range<size_t>& range, Sum s) {
-        std::vector<const VoxelGaussian*> near;
         for (size_t i = range.begin(); i < range.end(); ++i) {
           const Eigen::Vector3d x = T * source.points[i];
-          target.near(x, near);
-          double best = std::numeric_limits<double>::infinity();
-          for (const VoxelGaussian* v : near)
-            best = std::min(best, std::abs(v->normal.dot(x - v->mean)));
+          const VoxelGaussian* v = target.at(x);
+          if (v == nullptr) continue;
+          const double best = std::abs(v->normal.dot(x - v->mean));
           if (best < inlier_distance_m) {
             s.squared += best * best;
             ++s.inliers;
@@ -91,20 +89,19 @@ struct Correspondence {
   const VoxelGaussian* voxel;
 };
 
-/// The terms at pose T: each source point with the voxels around it (voxel_gaussians.hpp).
+/// The terms at pose T: each source point with the voxel it falls in (voxel_gaussians.hpp).
 std::vector<Correspondence> correspond(const VoxelGaussians& target, const GaussianCloud& source,
                                        const Eigen::Isometry3d& T) {
-  std::vector<std::vector<const VoxelGaussian*>> per_point(source.size());
+  std::vector<const VoxelGaussian*> voxel_of(source.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, source.size(), 512),
                     [&](const tbb::blocked_range<size_t>& range) {
-                      for (size_t i = range.begin(); i < range.end(); ++i) {
-                        target.near(T * source.points[i], per_point[i]);
-                      }
+                      for (size_t i = range.begin(); i < range.end(); ++i)
+                        voxel_of[i] = target.at(T * source.points[i]);
                     });
   std::vector<Correspondence> out;
-  for (size_t i = 0; i < per_point.size(); ++i) {
-    for (const VoxelGaussian* v : per_point[i]) out.push_back({static_cast<uint32_t>(i), v});
-  }
+  out.reserve(source.size());
+  for (size_t i = 0; i < voxel_of.size(); ++i)
+    if (voxel_of[i] != nullptr) out.push_back({static_cast<uint32_t>(i), voxel_of[i]});
   return out;
 }
 

@@ -51,13 +51,11 @@ void VoxelGaussians::finish() {
   }
 }
 
-void VoxelGaussians::near(const Eigen::Vector3d& p,
-                          std::vector<const VoxelGaussian*>& found) const {
-  found.clear();
+const VoxelGaussian* VoxelGaussians::at(const Eigen::Vector3d& p) const {
   const auto it = voxels_.find(voxel_key(static_cast<int64_t>(std::floor(p.x() / voxel_m_)),
                                          static_cast<int64_t>(std::floor(p.y() / voxel_m_)),
                                          static_cast<int64_t>(std::floor(p.z() / voxel_m_))));
-  if (it != voxels_.end()) found.push_back(&it->second);
+  return it != voxels_.end() ? &it->second : nullptr;
 }
 
 }  // namespace featsense::slam::refine

@@ -31,9 +31,9 @@ class VoxelGaussians {
   /// its mean, weighted by its points, so that the voxels are those of its points.
   VoxelGaussians(const std::vector<VoxelGaussian>& parts, double voxel_m);
 
-  /// The voxel holding `p`, if it holds points (nothing else: a neighbour's mean would pull
-  /// the point towards a surface it does not lie on).
-  void near(const Eigen::Vector3d& p, std::vector<const VoxelGaussian*>& found) const;
+  /// The voxel holding `p`, where it holds points, else nullptr (nothing else: a neighbour's
+  /// mean would pull the point towards a surface it does not lie on).
+  const VoxelGaussian* at(const Eigen::Vector3d& p) const;
 
   size_t size() const { return voxels_.size(); }
   double voxel_m() const { return voxel_m_; }
