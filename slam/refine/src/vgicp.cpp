@@ -6,7 +6,6 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -60,9 +59,9 @@ VgicpFit measure_fit(const VoxelGaussians& target, const GaussianCloud& source,
           const Eigen::Vector3d x = T * source.points[i];
           const VoxelGaussian* v = target.at(x);
           if (v == nullptr) continue;
-          const double best = std::abs(v->normal.dot(x - v->mean));
-          if (best < inlier_distance_m) {
-            s.squared += best * best;
+          const double distance = std::abs(v->normal.dot(x - v->mean));
+          if (distance < inlier_distance_m) {
+            s.squared += distance * distance;
             ++s.inliers;
           }
         }
