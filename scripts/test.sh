@@ -21,6 +21,18 @@ if ! command -v chromium >/dev/null; then
     echo "warning: chromium not installed; the browser tests will be skipped"
 fi
 build="${FEATSENSE_BUILD_DIR:-$root/build}"
+# A build with its tests takes about 3.5 GB (objects with debug information); a disk that
+# fills halfway fails at some link with "No space left on device". Say so before it starts.
+need_kb=$((3500 * 1024))
+[ -d "$build" ] && need_kb=$((need_kb - $(du -sk "$build" | cut -f1)))
+parent="$build"
+while [ ! -d "$parent" ]; do parent=$(dirname "$parent"); done
+free_kb=$(df -Pk "$parent" | awk 'NR == 2 { print $4 }')
+if [ "$need_kb" -gt 0 ] && [ "$free_kb" -lt "$need_kb" ]; then
+  echo "scripts/test.sh: $((free_kb / 1024)) MB free on the disk of $build;" \
+    "the build and its tests need about $((need_kb / 1024)) MB more" >&2
+  exit 1
+fi
 cmake -S "$root" -B "$build" -G Ninja -DFEATSENSE_BUILD_TESTS=ON "$@"
 cmake --build "$build" --parallel "$(nproc)"
 cd "$build"
