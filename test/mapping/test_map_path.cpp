@@ -169,5 +169,59 @@ TEST(MapFitSurface, ThePoseIsWorthWhatTheSurfacesItStandsOnWereSeenFrom) {
   EXPECT_GT(shift, 0.5 * far_fit.surface_position_m);
 }
 
+TEST(MapFitUpright, TheGroundFitsAnywhereWhatStandsOnItTellsThePlace) {
+  const MapPath path(std::vector<Eigen::Vector3d>{{0.0, 0.0, 2.0}, {0.0, 40.0, 2.0}});
+  const Eigen::Vector3d sensor(0.0, 3.0, 2.0);
+  MapTarget target = target_of(
+      street([](const Eigen::Vector3d&, const Eigen::Vector3d&) { return 0.0; }), path, sensor);
+  // The map observed the street's whole space between its walls, not only its surfaces.
+  for (double x = -29.75; x < 8.0; x += 0.5)
+    for (double y = -7.75; y < 55.0; y += 0.5)
+      for (double z = 0.25; z < 4.0; z += 0.5)
+        target.observed.insert(grid_key(grid_index(Eigen::Vector3d(x, y, z), 0.5)));
+  const slam::refine::GaussianCloud scan = scan_at(sensor);
+  // The scan's upright points by the normals the street was made with.
+  size_t upright = 0;
+  for (const Eigen::Vector3d& p : scan.points)
+    upright += std::abs((p + sensor).z()) > 1e-9;  // not on the ground
+
+  const MapFit right =
+      measure_map_fit(target, scan, Eigen::Isometry3d(Eigen::Translation3d(sensor)), 0.2);
+  EXPECT_EQ(right.upright_observed, upright);
+  // (The walls' lowest row shares its voxels with the ground: their plane is neither.)
+  EXPECT_GT(right.upright_inlier_fraction, 0.9);
+  EXPECT_GT(right.inlier_fraction, 0.95);
+
+  // 3 m across the street: the ground and the walls across it fit as well as before, the
+  // wall along it stands in the street's open space.
+  const Eigen::Vector3d wrong = sensor - Eigen::Vector3d(3.0, 0.0, 0.0);
+  const MapFit off =
+      measure_map_fit(target, scan, Eigen::Isometry3d(Eigen::Translation3d(wrong)), 0.2);
+  EXPECT_GT(off.inlier_fraction, 0.7);
+  EXPECT_LT(off.upright_inlier_fraction, 0.6);
+  EXPECT_GT(off.upright_observed, upright / 2);
+
+  // Turned and tilted, the upright points are the same ones: the normal is read in the map's
+  // frame.
+  const Eigen::Isometry3d turned =
+      Eigen::Translation3d(sensor) *
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 0.1, 1.0).normalized());
+  slam::refine::GaussianCloud turned_scan;
+  for (size_t i = 0; i < scan.size(); ++i) {
+    turned_scan.points.push_back(turned.linear().transpose() * scan.points[i]);
+    turned_scan.covariances.push_back(turned.linear().transpose() * scan.covariances[i] *
+                                      turned.linear());
+  }
+  // (Points on a block's face may change block with the rounding: counted as the fit does.)
+  size_t turned_upright = 0;
+  for (size_t i = 0; i < scan.size(); ++i) {
+    const Eigen::Vector3d q = turned * turned_scan.points[i];
+    turned_upright += std::abs((scan.points[i] + sensor).z()) > 1e-9 &&
+                      target.observed.count(grid_key(grid_index(q, 0.5))) != 0;
+  }
+  EXPECT_GT(turned_upright, upright * 9 / 10);
+  EXPECT_EQ(measure_map_fit(target, turned_scan, turned, 0.2).upright_observed, turned_upright);
+}
+
 }  // namespace
 }  // namespace featsense::mapping

@@ -88,8 +88,6 @@ constexpr size_t kMinPoints = 30;
 /// The map keyframes' points where the surface has none: one kept per voxel this wide (the
 /// keyframes' own clouds are thinned to 0.4 m).
 constexpr double kKeyframePointVoxel = 0.4;
-/// A surface is upright (a wall, a post) where its normal's vertical part is at most this.
-constexpr double kUprightMaxNormalZ = 0.5;
 /// The map's path, from where its surfaces were seen: one position kept per this distance.
 constexpr double kPathSpacing = 2.0;
 
@@ -240,7 +238,8 @@ struct Localizer::State {
       check.rejection = fit.map.coverage < settings.min_coverage ? "surface: little of it mapped"
                         : fit.map.inlier_fraction < search_min_inlier_fraction()
                             ? "surface: inliers"
-                            : "surface: fit";
+                        : fit.good ? "surface: upright surfaces"
+                                   : "surface: fit";
     }
     return check;
   }
@@ -248,9 +247,26 @@ struct Localizer::State {
   double search_min_inlier_fraction() const {
     return std::min(1.0, settings.min_inlier_fraction + settings.search_extra_inliers);
   }
-  /// A fit good enough to be found by: a tracked scan's, with more of it on the map.
+  /// A fit good enough to be found by: a tracked scan's, with more of it on the map, and
+  /// its upright surfaces on the map's.
   bool found_firmly(const Fit& fit) const {
-    return fit.good && fit.map.inlier_fraction >= search_min_inlier_fraction();
+    return fit.good && fit.map.inlier_fraction >= search_min_inlier_fraction() && upright_fits(fit);
+  }
+  bool upright_fits(const Fit& fit) const {
+    return fit.map.upright_observed >= settings.search_min_upright_points &&
+           fit.map.upright_inlier_fraction >= settings.search_min_upright_inliers;
+  }
+  /// Why a fit that is good as a tracked scan's does not place the sensor from scratch.
+  std::string upright_shortfall_text(const Fit& fit) const {
+    char text[96];
+    if (fit.map.upright_observed < settings.search_min_upright_points) {
+      std::snprintf(text, sizeof text, "%zu points on upright surfaces the map observed",
+                    fit.map.upright_observed);
+    } else {
+      std::snprintf(text, sizeof text, "%d %% of its upright surfaces on the map's",
+                    static_cast<int>(100.0 * fit.map.upright_inlier_fraction));
+    }
+    return text;
   }
 
   static void add_search_counts(const slam::loops::RelocalizationCounts& from,
@@ -381,15 +397,16 @@ struct Localizer::State {
     out.registered = true;
     describe_fit(fit, out);
     // The keyframes that placed it fitted firmly (check_place); this scan confirms the place
-    // as a tracked scan would.
-    if (!fit.good) {
+    // as a tracked scan would, with its upright surfaces on the map's.
+    if (!fit.good || !upright_fits(fit)) {
       ++counts.unconfirmed_matches;
       const Eigen::Vector3d at = fit.result.T_target_source.translation();
       char text[240];
       std::snprintf(text, sizeof text,
                     "a match with the map's keyframes at (%.1f, %.1f, %.1f) that its surface "
                     "does not confirm (%s): searching on",
-                    at.x(), at.y(), at.z(), shortfall_text(fit).c_str());
+                    at.x(), at.y(), at.z(),
+                    (fit.good ? upright_shortfall_text(fit) : shortfall_text(fit)).c_str());
       out.event = text;
       // The relocalizer keeps a placement once made; a fresh one searches on, with the same
       // odometry.

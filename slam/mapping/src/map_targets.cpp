@@ -35,6 +35,18 @@ double ms_since(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+/// |n . up| for the normal n of a plane-like covariance (with_covariances: its spread
+/// replaced by (1, 1, eps) along its axes, eps 1e-3, or any multiple of that) and a unit
+/// vector `up`: up'C up = s (1 - (1 - eps) (n . up)^2), trace C = s (2 + eps). No eigen
+/// decomposition for each of a scan's points.
+double normal_vertical_part(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& up) {
+  constexpr double kEps = 1e-3;
+  const double trace = covariance.trace();
+  if (!(trace > 0.0)) return 1.0;
+  const double along = up.dot(covariance * up) * (2.0 + kEps) / trace;
+  return std::sqrt(std::clamp((1.0 - along) / (1.0 - kEps), 0.0, 1.0));
+}
+
 }  // namespace
 
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
@@ -49,15 +61,20 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
   // (rotation about the sensor, then translation): its row of the point-to-plane problem.
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   const Eigen::Vector3d sensor = T.translation();
-  for (const Eigen::Vector3d& p : cloud.points) {
-    const Eigen::Vector3d q = T * p;
+  // The map's vertical in the scan's frame, for how upright each point's surface is.
+  const Eigen::Vector3d up = T.linear().row(2).transpose();
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d q = T * cloud.points[i];
     if (target.observed.count(grid_key(grid_index(q, target.block_m))) == 0) continue;
     ++fit.observed;
+    const bool upright = normal_vertical_part(cloud.covariances[i], up) <= kUprightMaxNormalZ;
+    fit.upright_observed += upright;
     const slam::refine::VoxelGaussian* voxel = target.vgicp.fitness.at(q);
     if (voxel == nullptr) continue;
     const double d = voxel->normal.dot(q - voxel->mean);
     if (std::abs(d) > inlier_distance_m) continue;
     ++fit.inliers;
+    fit.upright_inliers += upright;
     squares += d * d;
     const Eigen::Vector3d& n = voxel->normal;
     Eigen::Matrix<double, 6, 1> row;
@@ -73,6 +90,10 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
   }
   if (fit.observed > 0)
     fit.inlier_fraction = static_cast<double>(fit.inliers) / static_cast<double>(fit.observed);
+  if (fit.upright_observed > 0) {
+    fit.upright_inlier_fraction =
+        static_cast<double>(fit.upright_inliers) / static_cast<double>(fit.upright_observed);
+  }
   if (fit.points > 0)
     fit.coverage = static_cast<double>(fit.observed) / static_cast<double>(fit.points);
   if (fit.inliers > 0) fit.fitness_m = std::sqrt(squares / static_cast<double>(fit.inliers));

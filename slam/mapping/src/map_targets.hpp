@@ -69,7 +69,16 @@ struct MapFit {
   /// many points hold it. 0 where the target has no path.
   double surface_position_m = 0.0;
   double surface_rotation_deg = 0.0;
+  /// The same counts for the scan's points on upright surfaces (walls, posts, trunks: the
+  /// normal of the scan's surface at the point within kUprightMaxNormalZ of level). The
+  /// ground is flat almost everywhere and fits at a place metres off as well as at the right
+  /// one; what tells a place from another that looks alike is what stands on the ground.
+  size_t upright_observed = 0;
+  size_t upright_inliers = 0;
+  double upright_inlier_fraction = 0.0;  ///< upright_inliers / upright_observed
 };
+/// A surface is upright where its normal's vertical part is at most this (60 deg from level).
+constexpr double kUprightMaxNormalZ = 0.5;
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
                        const Eigen::Isometry3d& T, double inlier_distance_m,
                        double surface_angle_sigma_rad = 0.0);
