@@ -309,8 +309,10 @@ struct Localizer::State {
     const bool held = fit.map.position_sigma_m <= settings.max_position_sigma_m &&
                       fit.map.rotation_sigma_deg <= settings.max_rotation_sigma_deg;
     // Nor is one that rests on surfaces the map saw from afar: however many points hold it,
-    // it is where those surfaces are, and they may be centimetres off.
-    const bool surfaces_sure = fit.map.surface_position_m <= settings.max_surface_position_m;
+    // it is where those surfaces are, and they may be centimetres off. The map's share and
+    // the scan's own (its points' spread) are independent: the pose is worth both together.
+    const bool surfaces_sure = std::hypot(fit.map.surface_position_m, fit.map.position_sigma_m) <=
+                               settings.max_surface_position_m;
     const bool inliers = fit.map.inlier_fraction >= settings.min_inlier_fraction;
     const bool close = fit.map.fitness_m <= settings.max_fitness_m;
     fit.good = enough && held && surfaces_sure && inliers && close;
@@ -355,7 +357,7 @@ struct Localizer::State {
         break;
       case Shortfall::kSurface:
         std::snprintf(text, sizeof text, "its surfaces, seen from afar, may move it %.0f mm",
-                      1000.0 * m.surface_position_m);
+                      1000.0 * std::hypot(m.surface_position_m, m.position_sigma_m));
         break;
       case Shortfall::kInliers:
         std::snprintf(text, sizeof text, "%d %% of the scan on it",
