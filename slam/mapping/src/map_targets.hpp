@@ -117,9 +117,12 @@ class MapTargets {
   MapTargets(const MapTargets&) = delete;
   MapTargets& operator=(const MapTargets&) = delete;
 
-  /// A target for a sensor at `position`: the newest whose centre lies within half the radius,
-  /// else one made now. Asks for the next in the background where the sensor has moved a
-  /// quarter of the radius from the newest's centre.
+  /// A target for a sensor at `position`. Asks for the next in the background where the
+  /// sensor has moved a quarter of the radius from the current one's centre, and takes it
+  /// where the sensor has moved three eighths of the radius, waiting for it if it is not
+  /// made yet (one made now where it is of no use there). Which target a scan is registered
+  /// to depends on where the sensor is, never on how fast the background was: a run over
+  /// the same scans gives the same poses to the bit.
   std::shared_ptr<const MapTarget> around(const Eigen::Vector3d& position);
 
   MapTargetCounts counts() const;
@@ -136,7 +139,9 @@ class MapTargets {
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::shared_ptr<const MapTarget> newest_;
+  std::shared_ptr<const MapTarget> current_;
+  /// The background's, once made, until it is taken.
+  std::shared_ptr<const MapTarget> next_;
   std::optional<Eigen::Vector3d> requested_;
   bool building_ = false;
   bool stop_ = false;
