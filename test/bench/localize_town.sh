@@ -3,8 +3,12 @@
 # map's frame is the simulation's, the run starting from the true first pose), then recordings
 # the map never saw localized in it with their truth beside them.
 #
-#   localize_town.sh WORK [PATH ...]   (default: drive walk kidnap drive-changed walk-changed lab)
+#   localize_town.sh WORK [PATH[@SCAN] ...]
+#                      (default: drive walk kidnap drive-changed walk-changed lab)
 #
+# PATH@SCAN localizes the recording from its scan SCAN on (`--start`), into WORK/loc_PATH@SCAN:
+# walk@300 and drive@160 start on the loop's streets, 70 m and 52 m from the loop's start (the
+# walk itself starts on a street the loop only crossed, 44 m from the loop's path).
 # kidnap is the drive with its scans 400-659 cut out (splice_recording.py): between two sweeps
 # the sensor is 114 m away, on another street. drive-changed and walk-changed are the drive
 # and the walk through the town on another day (--scene town-changed: the parked cars moved).
@@ -35,7 +39,10 @@ map_dir=$work/${MAP_DIR:-loop_map}
 [ -f "$map_dir/map.h5" ] ||
   "$featsense" map --quiet "$work/town_loop" -o "$map_dir" --no-mesh ${MAP_OPTIONS:-}
 here=$(dirname "$0")
-for path in "${paths[@]}"; do
+for spec in "${paths[@]}"; do
+  path=${spec%@*}
+  start=0
+  [ "$spec" = "$path" ] || start=${spec#*@}
   scene=town
   route=${path%-changed}
   [ "$route" = "$path" ] || scene=town-changed
@@ -54,11 +61,11 @@ for path in "${paths[@]}"; do
   [ -d "$work/town_$path" ] ||
     "$featsense" simulate --quiet --scene $scene --path "$route" --seed $seed -o "$work/town_$path"
   rc=0
-  /usr/bin/time -v -o "$work/loc_$path.time.txt" "$featsense" localize --quiet \
-    "$map_dir/map.h5" "$work/town_$path" -o "$work/loc_$path" \
+  /usr/bin/time -v -o "$work/loc_$spec.time.txt" "$featsense" localize --quiet \
+    "$map_dir/map.h5" "$work/town_$path" -o "$work/loc_$spec" --start "$start" \
     --gt "$work/town_$path/gt_trajectory.tum" || rc=$?
-  python3 - "$work/loc_$path/report.json" "$path" "$rc" "$work/town_loop/gt_trajectory.tum" \
-    "$work/town_$path/gt_trajectory.tum" "$work/loc_$path/localization.csv" <<'PY'
+  python3 - "$work/loc_$spec/report.json" "$spec" "$rc" "$work/town_loop/gt_trajectory.tum" \
+    "$work/town_$path/gt_trajectory.tum" "$work/loc_$spec/localization.csv" "$start" <<'PY'
 import csv, json, math, sys
 r = json.load(open(sys.argv[1]))
 loc, ev, t = r["localization"], r.get("eval", {}), r["timings"]
@@ -86,7 +93,10 @@ def positions(path):
 # The share localized after the first fix, by the sensor's true distance from the loop's path.
 loop = positions(sys.argv[4])[::2]
 rows = list(csv.DictReader(open(sys.argv[6])))
-truth = positions(sys.argv[5])
+truth = positions(sys.argv[5])[int(sys.argv[7]):]
+# Where the run starts: how far from the loop's start and from its path.
+out["start_from_loop_start_m"] = round(math.dist(truth[0], loop[0]), 1)
+out["start_from_loop_path_m"] = round(min(math.dist(truth[0], p) for p in loop), 1)
 bins = {"within_20_m": [0, 0], "20_to_30_m": [0, 0], "beyond_30_m": [0, 0]}
 fixed = False
 for row, (x, y) in zip(rows, truth):
