@@ -155,6 +155,39 @@ TEST_F(CliLocalize, AnotherPathThroughTheMappedRoomIsFoundAndTracked) {
   EXPECT_EQ(file_bytes(out / "topdown.png").substr(1, 3), "PNG");
 }
 
+TEST_F(CliLocalize, ASensorStandingStillIsFoundWithoutMoving) {
+  // A robot at its dock at power-on: three seconds at one place of the mapped room (the
+  // mapping walk's pose two seconds in), other noise. Standing, it makes no keyframe by
+  // moving; it is found from two of its scans a second apart.
+  const fs::path dir = scratch_dir("cli_localize_standing");
+  const std::vector<std::vector<double>> walk = read_tum_poses(input("walk") / "gt_trajectory.tum");
+  ASSERT_GT(walk.size(), 20u);
+  {
+    std::ofstream tum(dir / "stand.tum");
+    tum << std::fixed;
+    tum.precision(9);
+    for (int i = 0; i < 30; ++i) {
+      tum << 1700000000.0 + 0.1 * i;
+      for (const double v : walk[19]) tum << ' ' << v;
+      tum << '\n';
+    }
+  }
+  CommandResult run =
+      run_featsense("simulate --quiet --scene lab --seed 11 --trajectory " +
+                    (dir / "stand.tum").string() + " -o " + (dir / "stand").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const fs::path out = dir / "loc";
+  run = run_featsense("localize --quiet " + map().string() + " " + (dir / "stand").string() +
+                      " -o " + out.string() + " --no-plan --gt " +
+                      (dir / "stand" / "gt_trajectory.tum").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json report = read_json(out / "report.json");
+  const nlohmann::json& found = report["localization"];
+  EXPECT_LE(found["first_fix"]["seconds_in"].get<double>(), 1.5) << found.dump(2);
+  EXPECT_EQ(found["localized_share_after_first_fix"].get<double>(), 1.0) << found.dump(2);
+  EXPECT_LT(report["eval"]["localized"]["translation_m"]["max"].get<double>(), 0.06);
+}
+
 TEST_F(CliLocalize, TheSameRecordingGivesTheSamePosesEveryRun) {
   // The surface around the sensor is gathered in the background as it moves: with a radius
   // of 10 m, anew every 2.5-3.75 m of the drone's 8 m. Which a scan is registered to must

@@ -137,6 +137,7 @@ struct Localizer::State {
     new_relocalizer();
     selector = std::make_unique<slam::loops::KeyframeSelector>(
         search_settings.loop.keyframe_distance_m, search_settings.loop.keyframe_angle_deg);
+    last_search_keyframe_ns.reset();
     last.reset();
     before_last.reset();
   }
@@ -381,7 +382,7 @@ struct Localizer::State {
     if (!odometry) start_search(initial_pose, true);
     std::string why;
     const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
-    if (!placed || !selector->next(placed->T_map_sensor)) return out;
+    if (!placed || !next_search_keyframe(*placed, scan.stamp_ns)) return out;
     const std::vector<Eigen::Vector3f> points =
         slam::refine::voxel_centroids(scan, *placed, relocalize.loop.cloud_voxel_m);
     const std::optional<slam::loops::Relocalization> found = relocalizer->add_keyframe(
@@ -456,8 +457,21 @@ struct Localizer::State {
     // The scan that lost it is the first of the search.
     std::string why;
     const std::optional<slam::ScanPlacement> placed = odometry->locate(scan, why);
-    if (placed) selector->next(placed->T_map_sensor);
+    if (placed) next_search_keyframe(*placed, scan.stamp_ns);
     return out;
+  }
+
+  /// Whether the search's scan at `placed` makes a keyframe: where the sensor has moved
+  /// far enough from the last (the mapping's keyframe spacing), or where it has stood
+  /// search_keyframe_interval_s since (a robot at rest at its dock is found without moving).
+  bool next_search_keyframe(const slam::ScanPlacement& placed, int64_t stamp_ns) {
+    const bool moved = selector->next(placed.T_map_sensor);
+    const bool waited = last_search_keyframe_ns &&
+                        1e-9 * static_cast<double>(stamp_ns - *last_search_keyframe_ns) >=
+                            settings.search_keyframe_interval_s;
+    if (!moved && !waited) return false;
+    last_search_keyframe_ns = stamp_ns;
+    return true;
   }
 
   LocalizedScan track(const slam::Scan& scan) {
@@ -601,6 +615,7 @@ struct Localizer::State {
   /// Targets of the places the search checked, the latest first.
   std::list<std::pair<std::array<int64_t, 2>, std::shared_ptr<const MapTarget>>> search_targets;
   std::unique_ptr<slam::loops::KeyframeSelector> selector;
+  std::optional<int64_t> last_search_keyframe_ns;
   /// The current search's settings: relocalize.*, with the guess where it has a belief.
   slam::loops::RelocalizeSettings search_settings;
   std::optional<Pose> last;

@@ -111,6 +111,11 @@ struct LocalizerSettings {
   /// streets are much alike: more candidates are checked than `map --continue` checks.
   double search_radius_m = 30.0;
   std::vector<double> search_voxel_sizes_m = {2.0, 1.0, 0.5};
+  /// The search's keyframes are made as the mapping's are (loop.keyframe_distance and
+  /// keyframe_angle_deg of motion), and where the sensor has not moved that much, one this
+  /// often: a robot standing still (at its dock, at power-on) is found without moving, from
+  /// two of its scans that agree on its place.
+  double search_keyframe_interval_s = 1.0;
   /// Targets of places checked kept for the next keyframes' candidates (the same places).
   size_t search_targets_kept = 8;
   size_t search_ring_candidates = 50;
