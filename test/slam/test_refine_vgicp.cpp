@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <vector>
 
 #include "common/test_data.hpp"
@@ -30,6 +31,35 @@ std::vector<Eigen::Vector3f> moved(const std::vector<Eigen::Vector3f>& points,
   std::vector<Eigen::Vector3f> out;
   for (const auto& p : points) out.push_back((T * p.cast<double>()).cast<float>());
   return out;
+}
+
+TEST(GaussianCloud, ANormalsAlignmentIsTheOneAnEigenSolverFinds) {
+  // Points of a tilted roof, a wall and a rough slope, their covariances turned as a sensor's.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> along(-2.0f, 2.0f), noise(-0.01f, 0.01f);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 300; ++i) {
+    const float a = along(random), b = along(random);
+    points.emplace_back(a, b, 0.3f * a + noise(random));
+    points.emplace_back(5.0f + noise(random), a, b);
+    points.emplace_back(a, 6.0f + 0.8f * b + 0.2f * a, b + noise(random) * 10.0f);
+  }
+  const GaussianCloud cloud = with_covariances(points, 10);
+  ASSERT_GT(cloud.size(), 800u);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()).toRotationMatrix();
+  const Eigen::Vector3d direction = Eigen::Vector3d(0.2, 0.4, 1.0).normalized();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Matrix3d turned = R * cloud.covariances[i] * R.transpose();
+    eigen.compute(turned);
+    EXPECT_NEAR(normal_alignment(turned, direction),
+                std::abs(eigen.eigenvectors().col(0).dot(direction)), 1e-6)
+        << "point " << i;
+    // Any multiple of it alike.
+    EXPECT_NEAR(normal_alignment(3.0 * turned, direction), normal_alignment(turned, direction),
+                1e-9);
+  }
 }
 
 TEST(Vgicp, GradientAndHessianMatchTheCost) {

@@ -40,18 +40,6 @@ double ms_since(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-/// |n . up| for the normal n of a plane-like covariance (with_covariances: its spread
-/// replaced by (1, 1, eps) along its axes, eps 1e-3, or any multiple of that) and a unit
-/// vector `up`: up'C up = s (1 - (1 - eps) (n . up)^2), trace C = s (2 + eps). No eigen
-/// decomposition for each of a scan's points.
-double normal_vertical_part(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& up) {
-  constexpr double kEps = 1e-3;
-  const double trace = covariance.trace();
-  if (!(trace > 0.0)) return 1.0;
-  const double along = up.dot(covariance * up) * (2.0 + kEps) / trace;
-  return std::sqrt(std::clamp((1.0 - along) / (1.0 - kEps), 0.0, 1.0));
-}
-
 }  // namespace
 
 MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianCloud& cloud,
@@ -72,7 +60,8 @@ MapFit measure_map_fit(const MapTarget& target, const slam::refine::GaussianClou
     const Eigen::Vector3d q = T * cloud.points[i];
     if (target.observed.count(grid_key(grid_index(q, target.block_m))) == 0) continue;
     ++fit.observed;
-    const bool upright = normal_vertical_part(cloud.covariances[i], up) <= kUprightMaxNormalZ;
+    const bool upright =
+        slam::refine::normal_alignment(cloud.covariances[i], up) <= kUprightMaxNormalZ;
     fit.upright_observed += upright;
     const slam::refine::VoxelGaussian* voxel = target.vgicp.fitness.at(q);
     if (voxel == nullptr) continue;

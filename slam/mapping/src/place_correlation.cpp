@@ -1,7 +1,5 @@
 #include "place_correlation.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -163,11 +161,11 @@ std::vector<Eigen::Vector3d> upright_points(const slam::refine::GaussianCloud& c
                                             double max_normal_z) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(cloud.size());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  // The map's vertical in the sensor's frame.
+  const Eigen::Vector3d up = R_map_sensor.row(2).transpose();
   for (size_t i = 0; i < cloud.size(); ++i) {
-    eigen.computeDirect(cloud.covariances[i]);
-    const Eigen::Vector3d normal = R_map_sensor * eigen.eigenvectors().col(0);
-    if (std::abs(normal.z()) <= max_normal_z) out.push_back(cloud.points[i]);
+    if (slam::refine::normal_alignment(cloud.covariances[i], up) <= max_normal_z)
+      out.push_back(cloud.points[i]);
   }
   return out;
 }

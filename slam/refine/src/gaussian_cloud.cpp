@@ -6,6 +6,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace featsense::slam::refine {
@@ -26,15 +27,27 @@ struct PointView {
 using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointView>,
                                                    PointView, 3, uint32_t>;
 
-/// Plane-like: the neighbourhood's axes kept, its spread replaced by (1, 1, 1e-3).
+/// A plane-like covariance's spread across the plane; along it, 1.
+constexpr double kThickness = 1e-3;
+
+/// Plane-like: the neighbourhood's axes kept, its spread replaced by (1, 1, kThickness).
 Eigen::Matrix3d regularised(const Eigen::Matrix3d& covariance) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
   eigen.computeDirect(covariance);
-  const Eigen::Vector3d values(1e-3, 1.0, 1.0);  // ascending, as the eigenvalues
+  const Eigen::Vector3d values(kThickness, 1.0, 1.0);  // ascending, as the eigenvalues
   return eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
 }  // namespace
+
+double normal_alignment(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& direction) {
+  // C = I - (1 - t) n n' (t the thickness): d'C d = 1 - (1 - t) (n . d)^2, trace C = 2 + t
+  // (both scaled alike where C is).
+  const double trace = covariance.trace();
+  if (!(trace > 0.0)) return 1.0;
+  const double along = direction.dot(covariance * direction) * (2.0 + kThickness) / trace;
+  return std::sqrt(std::clamp((1.0 - along) / (1.0 - kThickness), 0.0, 1.0));
+}
 
 GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& input, int neighbours,
                                std::vector<uint32_t>* kept, size_t every) {

@@ -26,6 +26,11 @@ struct GaussianCloud {
 GaussianCloud with_covariances(const std::vector<Eigen::Vector3f>& points, int neighbours,
                                std::vector<uint32_t>* kept = nullptr, size_t every = 1);
 
+/// |n . direction| for the normal n (the thinnest axis) of a covariance with_covariances made,
+/// or one turned from it (R C R^T), and a unit `direction`: read off the covariance, whose
+/// spread along its axes is known, without an eigen decomposition for each point.
+double normal_alignment(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& direction);
+
 /// The cloud moved by T: points T p, covariances R C R^T.
 GaussianCloud transformed(const GaussianCloud& cloud, const Eigen::Isometry3d& T);
 
